@@ -1,0 +1,191 @@
+//! Command-line arguments shared by the subcommands, with range checks that name the flag.
+
+use clap::Args;
+use glam::Vec3;
+use raylab_core::kdtree::KdParams;
+use raylab_core::scene::{Camera, PointLight, Scene};
+use raylab_scene::SceneSource;
+
+/// Parses `X,Y,Z`.
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!("expected X,Y,Z, got '{s}'"));
+    }
+    let mut v = [0f32; 3];
+    for (out, p) in v.iter_mut().zip(&parts) {
+        let x: f32 = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' is not a number"))?;
+        if !x.is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+        *out = x;
+    }
+    Ok(Vec3::from_array(v))
+}
+
+/// A clap value parser for integers in `lo..=hi`.
+pub fn in_range(
+    lo: u64,
+    hi: u64,
+) -> impl Fn(&str) -> Result<u64, String> + Clone + Send + Sync + 'static {
+    move |s: &str| {
+        let v: u64 = s
+            .parse()
+            .map_err(|_| format!("'{s}' is not a whole number"))?;
+        if (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("{v} is out of range {lo}..={hi}"))
+        }
+    }
+}
+
+/// The scene, camera and light flags.
+#[derive(Args, Clone, Debug)]
+pub struct SceneArgs {
+    /// Built-in scene name (atrium, arena, kitchen, forest) or path to an .obj file.
+    #[arg(long, default_value = "atrium")]
+    pub scene: String,
+    /// Named view of the scene (defaults to its first).
+    #[arg(long)]
+    pub view: Option<String>,
+    /// Camera position X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Point looked at X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Up vector X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
+    /// Vertical field of view in degrees, in (0, 180).
+    #[arg(long)]
+    pub fov: Option<f32>,
+    /// Point light position X,Y,Z (defaults to the scene's light).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub light: Option<Vec3>,
+}
+
+impl SceneArgs {
+    /// Where the scene comes from.
+    pub fn source(&self) -> SceneSource {
+        SceneSource::parse(&self.scene)
+    }
+
+    /// The camera and light: the scene's own, overridden by the flags.
+    pub fn camera_and_light(&self, scene: &Scene) -> Result<(Camera, PointLight), String> {
+        let base = match &self.view {
+            Some(name) => scene.view(name).map(|v| v.camera).ok_or_else(|| {
+                let names: Vec<_> = scene.views.iter().map(|v| v.name.as_str()).collect();
+                format!(
+                    "--view: no view '{name}' in this scene (views: {})",
+                    names.join(", ")
+                )
+            })?,
+            None => scene
+                .default_view()
+                .map(|v| v.camera)
+                .unwrap_or_else(|| default_camera(scene)),
+        };
+        let mut cam = base;
+        cam.eye = self.eye.unwrap_or(cam.eye);
+        cam.target = self.target.unwrap_or(cam.target);
+        cam.up = self
+            .up
+            .unwrap_or(if self.eye.is_some() || self.target.is_some() {
+                Vec3::Y
+            } else {
+                cam.up
+            });
+        cam.vfov_deg = self
+            .fov
+            .unwrap_or(if self.view.is_none() && self.eye.is_some() {
+                60.0
+            } else {
+                cam.vfov_deg
+            });
+        cam.validate()
+            .map_err(|e| format!("camera (--eye/--target/--up/--fov): {e}"))?;
+        let mut light = scene
+            .lights
+            .first()
+            .copied()
+            .unwrap_or_else(|| PointLight::at(default_light(scene)));
+        if let Some(p) = self.light {
+            light = PointLight {
+                position: p,
+                ..light
+            };
+        }
+        Ok((cam, light))
+    }
+}
+
+/// A view of the whole scene from outside its box, for files that carry no view.
+fn default_camera(scene: &Scene) -> Camera {
+    let b = scene.bounds();
+    let c = b.center();
+    let eye = c + Vec3::new(0.6, 0.4, 1.0) * b.diagonal().max(1.0);
+    Camera::look_at(eye, c, Vec3::Y, 60.0)
+}
+
+fn default_light(scene: &Scene) -> Vec3 {
+    let b = scene.bounds();
+    b.center() + Vec3::Y * b.extent().y.max(1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vec3_parsing() {
+        assert_eq!(parse_vec3("1,-2.5, 3"), Ok(Vec3::new(1.0, -2.5, 3.0)));
+        assert!(parse_vec3("1,2").is_err());
+        assert!(parse_vec3("1,2,x").unwrap_err().contains("'x'"));
+        assert!(parse_vec3("1,2,inf").is_err());
+    }
+
+    #[test]
+    fn ranges() {
+        let p = in_range(1, 16);
+        assert_eq!(p("4"), Ok(4));
+        assert!(p("0").unwrap_err().contains("1..=16"));
+        assert!(p("-1").is_err());
+    }
+}
+
+/// kd-tree cost-model flags (thesis Eq. 2.1); the defaults are [`KdParams::default`].
+#[derive(Args, Clone, Debug)]
+pub struct KdArgs {
+    /// Traversal cost C_traversal of the SAH.
+    #[arg(long, default_value_t = KdParams::default().c_trav)]
+    pub kd_ctrav: f32,
+    /// Intersection cost C_intersect of the SAH (the thesis uses 5 x C_traversal).
+    #[arg(long, default_value_t = KdParams::default().c_isect)]
+    pub kd_cisect: f32,
+    /// Empty-space bonus in [0, 1).
+    #[arg(long, default_value_t = KdParams::default().empty_bonus)]
+    pub kd_empty_bonus: f32,
+    /// Maximum tree depth (default: 8 + 1.3 log2 N).
+    #[arg(long, value_parser = in_range(1, KdParams::DEPTH_LIMIT as u64))]
+    pub kd_max_depth: Option<u64>,
+}
+
+impl KdArgs {
+    /// The parameters, checked; the error names the flag.
+    pub fn params(&self) -> Result<KdParams, String> {
+        let p = KdParams {
+            c_trav: self.kd_ctrav,
+            c_isect: self.kd_cisect,
+            empty_bonus: self.kd_empty_bonus,
+            max_depth: self.kd_max_depth.map(|d| d as u32),
+            ..KdParams::default()
+        };
+        p.validate().map_err(|m| format!("--kd-*: {m}"))?;
+        Ok(p)
+    }
+}

@@ -1,0 +1,279 @@
+//! `raylab-bench compare`: the Embree harness and raylab on the same OBJ, view, light and rays, one after
+//! the other in one invocation, printed as one markdown table for `docs/BENCHMARKS.md`.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::process::Command;
+
+use clap::Args;
+use raylab_core::kdtree::KdTree;
+use raylab_core::reference::BruteForce;
+use raylab_core::workload::{RayKind, WorkloadBuilder};
+
+use crate::args::{KdArgs, SceneArgs, in_range};
+use crate::env::Environment;
+use crate::prepare::{build_tree, load_scene, with_spinner};
+use crate::timing::{TraceReport, measure, validate};
+
+/// Compares raylab's single-ray kd-tree with Embree's single-ray API on the harness's rays.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// Path to the built `embree_bench` binary (see shared/tools/embree-bench).
+    #[arg(long)]
+    embree: PathBuf,
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    kd: KdArgs,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
+    width: u64,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
+    height: u64,
+    /// Thread counts, comma separated.
+    #[arg(long, default_value = "1,2", value_delimiter = ',', value_parser = in_range(1, 1024))]
+    threads: Vec<u64>,
+    /// Timed runs per configuration.
+    #[arg(long, default_value_t = 7, value_parser = in_range(1, 10_000))]
+    reps: u64,
+    /// Untimed runs before timing.
+    #[arg(long, default_value_t = 1, value_parser = in_range(0, 10_000))]
+    warmup: u64,
+    /// Acceleration-structure builds per thread count (the median is reported).
+    #[arg(long, default_value_t = 3, value_parser = in_range(1, 100))]
+    builds: u64,
+    /// Also write the markdown to this file.
+    #[arg(long)]
+    markdown: Option<PathBuf>,
+}
+
+/// Embree's numbers for one kind and thread count.
+struct EmbreeRow {
+    kind: String,
+    threads: u64,
+    median: f64,
+    min: f64,
+    max: f64,
+}
+
+struct EmbreeRun {
+    builds: Vec<(u64, f64)>,
+    rows: Vec<EmbreeRow>,
+    checks: Vec<String>,
+}
+
+fn run_embree(
+    a: &CompareArgs,
+    cam: &raylab_core::scene::Camera,
+    light: glam::Vec3,
+) -> Result<EmbreeRun, String> {
+    let v = |p: glam::Vec3| format!("{},{},{}", p.x, p.y, p.z);
+    let threads: Vec<String> = a.threads.iter().map(u64::to_string).collect();
+    let out = Command::new(&a.embree)
+        .arg(&a.scene.scene)
+        .args([
+            "--eye",
+            &v(cam.eye),
+            "--target",
+            &v(cam.target),
+            "--up",
+            &v(cam.up),
+        ])
+        .args(["--fov", &cam.vfov_deg.to_string(), "--light", &v(light)])
+        .args([
+            "--width",
+            &a.width.to_string(),
+            "--height",
+            &a.height.to_string(),
+        ])
+        .args([
+            "--threads",
+            &threads.join(","),
+            "--reps",
+            &a.reps.to_string(),
+        ])
+        .args([
+            "--warmup",
+            &a.warmup.to_string(),
+            "--builds",
+            &a.builds.to_string(),
+        ])
+        .args(["--kinds", "primary_1,shadow_1,diffuse_1"])
+        .output()
+        .map_err(|e| format!("--embree: cannot run {}: {e}", a.embree.display()))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() {
+        return Err(format!(
+            "{} failed: {}{}",
+            a.embree.display(),
+            text,
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let mut run = EmbreeRun {
+        builds: vec![],
+        rows: vec![],
+        checks: vec![],
+    };
+    for line in text.lines() {
+        if let Some(rest) = line.strip_prefix("build HIGH") {
+            // "       1 thread(s): median 0.108 s (min ...)"
+            let t: Option<u64> = rest.split_whitespace().next().and_then(|s| s.parse().ok());
+            let m: Option<f64> = rest
+                .split("median")
+                .nth(1)
+                .and_then(|s| s.split_whitespace().next()?.parse().ok());
+            if let (Some(t), Some(m)) = (t, m) {
+                run.builds.push((t, m));
+            }
+        } else if let Some(rest) = line.strip_prefix("CSV,") {
+            let f: Vec<&str> = rest.split(',').collect();
+            if f.len() >= 7 && f[0] != "res" {
+                let num = |i: usize| {
+                    f[i].parse::<f64>()
+                        .map_err(|_| format!("bad CSV line from embree: {line}"))
+                };
+                run.rows.push(EmbreeRow {
+                    kind: f[1].to_string(),
+                    threads: f[2]
+                        .parse()
+                        .map_err(|_| format!("bad CSV line from embree: {line}"))?,
+                    median: num(4)?,
+                    min: num(5)?,
+                    max: num(6)?,
+                });
+            }
+        } else if line.starts_with("## ")
+            || line.starts_with("shadow rays")
+            || line.starts_with("diffuse rays")
+        {
+            run.checks.push(line.trim_start_matches("## ").to_string());
+        }
+    }
+    if run.rows.is_empty() {
+        return Err(format!(
+            "no CSV rows in the output of {}",
+            a.embree.display()
+        ));
+    }
+    Ok(run)
+}
+
+/// Runs the command.
+pub fn run(a: &CompareArgs) -> Result<(), String> {
+    let env = Environment::detect();
+    let (scene, _) = load_scene(&a.scene.source())?;
+    let (cam, light) = a.scene.camera_and_light(&scene)?;
+    let embree = with_spinner("running the Embree harness", || {
+        run_embree(a, &cam, light.position)
+    })?;
+
+    let params = a.kd.params()?;
+    let mut builds = Vec::new();
+    let mut tree: Option<KdTree> = None;
+    for &t in &a.threads {
+        let mut times = Vec::new();
+        for _ in 0..a.builds {
+            let built = build_tree(&scene, &params, t as usize)?;
+            times.push(built.build_time().as_secs_f64());
+            tree = Some(built);
+        }
+        times.sort_by(f64::total_cmp);
+        builds.push((t, times[times.len() / 2]));
+    }
+    let tree = tree.ok_or("--threads: no thread count given")?;
+    let reference = BruteForce::new(&scene);
+    let (w, h) = (a.width as u32, a.height as u32);
+    let wb = with_spinner("generating rays", || {
+        WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree)
+    });
+    let mut ours: Vec<TraceReport> = Vec::new();
+    for kind in RayKind::ALL {
+        let workload = wb.build(kind);
+        for &t in &a.threads {
+            let (report, results) = measure(
+                &tree,
+                &workload,
+                t as usize,
+                a.warmup as usize,
+                a.reps as usize,
+            )?;
+            validate(&reference, &workload, &results, 256)
+                .map_err(|m| format!("validation failed: {m}"))?;
+            ours.push(report);
+        }
+    }
+
+    let mut md = String::new();
+    let cmd: Vec<String> = std::env::args().collect();
+    let _ = writeln!(md, "Machine and build: {}.", env.line());
+    let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
+    let _ = writeln!(
+        md,
+        "\nEmbree harness checks: {}.\n",
+        embree.checks.join("; ")
+    );
+    let _ = writeln!(
+        md,
+        "| rays | threads | raylab mono Mrays/s (min-max) | Embree API | Embree Mrays/s (min-max) | raylab / Embree | raylab hits, sum_t | nodes/ray | tests/ray |"
+    );
+    let _ = writeln!(md, "|---|---:|---:|---|---:|---:|---|---:|---:|");
+    for r in &ours {
+        let (api, ekind) = match r.kind {
+            RayKind::Primary => ("rtcIntersect1", "primary_1"),
+            RayKind::Shadow => ("rtcOccluded1", "shadow_1"),
+            RayKind::Diffuse => ("rtcIntersect1", "diffuse_1"),
+        };
+        let e = embree
+            .rows
+            .iter()
+            .find(|e| e.kind == ekind && e.threads == r.threads as u64);
+        let (es, ratio) = match e {
+            Some(e) => (
+                format!("{:.2} ({:.2}-{:.2})", e.median, e.min, e.max),
+                format!("{:.2}x", r.mrays_median / e.median),
+            ),
+            None => ("n/a".into(), "n/a".into()),
+        };
+        let check = if r.kind.is_occlusion() {
+            format!("{} occluded", r.hits)
+        } else {
+            format!("{} hits, {:.1}", r.hits, r.sum_t)
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.2} ({:.2}-{:.2}) | {} | {} | {} | {} | {:.1} | {:.1} |",
+            r.kind,
+            r.threads,
+            r.mrays_median,
+            r.mrays_min,
+            r.mrays_max,
+            api,
+            es,
+            ratio,
+            check,
+            r.nodes_per_ray,
+            r.isects_per_ray
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\n| build | threads | raylab kd-tree (SAH, perfect splits) s | Embree BVH (HIGH) s |"
+    );
+    let _ = writeln!(md, "|---|---:|---:|---:|");
+    for (t, s) in &builds {
+        let e = embree
+            .builds
+            .iter()
+            .find(|(et, _)| et == t)
+            .map_or("n/a".into(), |(_, s)| format!("{s:.3}"));
+        let _ = writeln!(md, "| median of {} | {} | {:.3} | {} |", a.builds, t, s, e);
+    }
+    print!("{md}");
+    if let Some(p) = &a.markdown {
+        std::fs::write(p, &md)
+            .map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
+    }
+    Ok(())
+}

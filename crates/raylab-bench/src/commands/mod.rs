@@ -1,0 +1,6 @@
+//! The subcommands.
+
+pub mod compare;
+pub mod info;
+pub mod render;
+pub mod trace;

@@ -1,0 +1,130 @@
+//! `raylab-bench trace`: throughput of one method on the harness's rays.
+
+use clap::Args;
+use raylab_core::kdtree::KdTree;
+use raylab_core::method::{Intersector, Method};
+use raylab_core::reference::BruteForce;
+use raylab_core::workload::{RayKind, WorkloadBuilder};
+use serde_json::json;
+
+use crate::args::{KdArgs, SceneArgs, in_range};
+use crate::env::Environment;
+use crate::prepare::{build_tree, load_scene, with_spinner};
+use crate::timing::{measure, validate};
+
+/// Traces the Embree harness's rays and reports Mrays/s, checksums and counters.
+#[derive(Args, Debug)]
+pub struct TraceArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    kd: KdArgs,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
+    width: u64,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
+    height: u64,
+    /// Ray kind: primary, shadow or diffuse.
+    #[arg(long, default_value = "primary")]
+    kind: RayKind,
+    /// Traversal method.
+    #[arg(long, default_value = "mono")]
+    method: Method,
+    /// Tracing threads.
+    #[arg(long, default_value_t = 1, value_parser = in_range(1, 1024))]
+    threads: u64,
+    /// Timed runs.
+    #[arg(long, default_value_t = 7, value_parser = in_range(1, 10_000))]
+    reps: u64,
+    /// Untimed runs before timing.
+    #[arg(long, default_value_t = 1, value_parser = in_range(0, 10_000))]
+    warmup: u64,
+    /// Diffuse-ray seed (the harness's --seed).
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Rays checked against the brute-force reference before any speed is reported (0 skips the check).
+    #[arg(long, default_value_t = 256, value_parser = in_range(0, 1_000_000))]
+    validate: u64,
+    /// Print one JSON object on stdout and nothing else.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs the command.
+pub fn run(a: &TraceArgs) -> Result<(), String> {
+    let env = Environment::detect();
+    let (scene, _) = load_scene(&a.scene.source())?;
+    let (camera, light) = a.scene.camera_and_light(&scene)?;
+    let tree = build_tree(&scene, &a.kd.params()?, a.threads as usize)?;
+    let reference = BruteForce::new(&scene);
+    let (w, h) = (a.width as u32, a.height as u32);
+    let builder = with_spinner("generating rays", || {
+        WorkloadBuilder::new(&scene, &camera, light.position, w, h, &tree).seed(a.seed)
+    });
+    let workload = builder.build(a.kind);
+    let tracer: &dyn Intersector = match a.method {
+        Method::Mono => &tree as &KdTree,
+        Method::Reference => &reference,
+    };
+    let (report, results) = measure(
+        tracer,
+        &workload,
+        a.threads as usize,
+        a.warmup as usize,
+        a.reps as usize,
+    )?;
+    let checked = with_spinner("validating against brute force", || {
+        validate(&reference, &workload, &results, a.validate as usize)
+    })
+    .map_err(|m| format!("validation failed ({} vs brute force): {m}", a.method))?;
+    if a.json {
+        let v = json!({
+            "environment": env,
+            "scene": a.scene.scene,
+            "triangles": scene.triangle_count(),
+            "camera": camera,
+            "light": light.position.to_array(),
+            "width": w,
+            "height": h,
+            "method": a.method,
+            "kd_build_seconds": tree.build_time().as_secs_f64(),
+            "validated_rays": checked,
+            "result": report,
+        });
+        println!("{v}");
+        return Ok(());
+    }
+    println!("environment      {}", env.line());
+    println!(
+        "scene            {} ({} triangles), {}x{}",
+        a.scene.scene,
+        scene.triangle_count(),
+        w,
+        h
+    );
+    println!(
+        "kd-tree          built in {:.3} s on {} thread(s)",
+        tree.build_time().as_secs_f64(),
+        a.threads
+    );
+    println!("validated        {checked} rays against brute force");
+    let what = if a.kind.is_occlusion() {
+        "occluded"
+    } else {
+        "hits"
+    };
+    println!(
+        "{} {} threads {}: rays {}, {} {}, sum_t {:.6}",
+        a.kind, a.method, report.threads, report.rays, what, report.hits, report.sum_t
+    );
+    println!(
+        "Mrays/s          median {:.2} (min {:.2}, max {:.2}) over {} runs",
+        report.mrays_median, report.mrays_min, report.mrays_max, a.reps
+    );
+    println!(
+        "per ray          {:.2} nodes, {:.2} leaves, {:.2} triangle tests",
+        report.nodes_per_ray, report.leaves_per_ray, report.isects_per_ray
+    );
+    Ok(())
+}

@@ -1,0 +1,52 @@
+//! `raylab-bench`: raylab's headless command line.
+//!
+//! With no subcommand it renders the default built-in scene to `raylab.png`.
+
+mod args;
+mod commands;
+mod env;
+mod prepare;
+mod timing;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "raylab-bench",
+    version,
+    about = "raylab's headless renderer and benchmark"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render one frame to PNG.
+    Render(commands::render::RenderArgs),
+    /// Trace the Embree harness's rays with one method and report Mrays/s, checksums and counters.
+    Trace(commands::trace::TraceArgs),
+    /// Print a scene's contents and kd-tree statistics.
+    Info(commands::info::InfoArgs),
+    /// Run the Embree harness and raylab on the same view in one go, and print the comparison table.
+    Compare(commands::compare::CompareArgs),
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        None => commands::render::run(&commands::render::RenderArgs::default_scene()),
+        Some(Command::Render(a)) => commands::render::run(a),
+        Some(Command::Trace(a)) => commands::trace::run(a),
+        Some(Command::Info(a)) => commands::info::run(a),
+        Some(Command::Compare(a)) => commands::compare::run(a),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            std::process::ExitCode::from(1)
+        }
+    }
+}

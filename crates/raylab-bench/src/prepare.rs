@@ -1,0 +1,41 @@
+//! Loading a scene and building its kd-tree, with a spinner on a terminal.
+
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use raylab_core::kdtree::{KdParams, KdTree};
+use raylab_core::scene::Scene;
+use raylab_scene::SceneSource;
+
+/// Runs `f` while a spinner with `msg` turns on stderr (hidden when stderr is not a terminal).
+pub fn with_spinner<T>(msg: &str, f: impl FnOnce() -> T) -> T {
+    let bar = ProgressBar::new_spinner();
+    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} {elapsed}") {
+        bar.set_style(style);
+    }
+    bar.set_message(msg.to_string());
+    bar.enable_steady_tick(Duration::from_millis(100));
+    let out = f();
+    bar.finish_and_clear();
+    out
+}
+
+/// Loads the scene named by `source`; the error names the scene or file.
+pub fn load_scene(source: &SceneSource) -> Result<(Scene, f64), String> {
+    let t0 = Instant::now();
+    let scene =
+        with_spinner("loading scene", || raylab_scene::load(source)).map_err(|e| e.to_string())?;
+    Ok((scene, t0.elapsed().as_secs_f64()))
+}
+
+/// Builds the kd-tree on a pool of `threads` threads.
+pub fn build_tree(scene: &Scene, params: &KdParams, threads: usize) -> Result<KdTree, String> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
+    with_spinner("building kd-tree", || {
+        pool.install(|| KdTree::build(scene, params))
+    })
+    .map_err(|e| e.to_string())
+}

@@ -1,0 +1,175 @@
+//! Axis-aligned bounding boxes.
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// An axis-aligned box given by its minimum and maximum corners.
+///
+/// The empty box has `min = +inf` and `max = -inf`, so that growing it by any point gives that point.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Aabb {
+    /// Minimum corner.
+    pub min: Vec3,
+    /// Maximum corner.
+    pub max: Vec3,
+}
+
+impl Default for Aabb {
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
+impl Aabb {
+    /// The empty box (contains nothing; the identity of [`Aabb::union`]).
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::INFINITY,
+        max: Vec3::NEG_INFINITY,
+    };
+
+    /// The box spanning two corners.
+    pub fn new(min: Vec3, max: Vec3) -> Self {
+        Self { min, max }
+    }
+
+    /// The smallest box holding all `points`.
+    pub fn from_points(points: impl IntoIterator<Item = Vec3>) -> Self {
+        points.into_iter().fold(Self::EMPTY, |b, p| b.grow(p))
+    }
+
+    /// This box grown to hold `p`.
+    pub fn grow(self, p: Vec3) -> Self {
+        Self {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    /// The smallest box holding both boxes.
+    pub fn union(self, o: Aabb) -> Self {
+        Self {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+
+    /// The overlap of both boxes (possibly empty).
+    pub fn intersection(self, o: Aabb) -> Self {
+        Self {
+            min: self.min.max(o.min),
+            max: self.max.min(o.max),
+        }
+    }
+
+    /// True when the box holds no point (some `min > max`).
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
+    }
+
+    /// Edge lengths (zero for an empty box).
+    pub fn extent(&self) -> Vec3 {
+        (self.max - self.min).max(Vec3::ZERO)
+    }
+
+    /// Length of the diagonal.
+    pub fn diagonal(&self) -> f32 {
+        self.extent().length()
+    }
+
+    /// Centre point.
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Surface area, the probability measure of the SAH (thesis Eq. 2.1); zero for an empty box.
+    pub fn surface_area(&self) -> f32 {
+        let e = self.extent();
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
+
+    /// Index (0, 1, 2) of the longest axis.
+    pub fn longest_axis(&self) -> usize {
+        let e = self.extent();
+        if e.x >= e.y && e.x >= e.z {
+            0
+        } else if e.y >= e.z {
+            1
+        } else {
+            2
+        }
+    }
+
+    /// True when `p` lies inside or on the boundary.
+    pub fn contains(&self, p: Vec3) -> bool {
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
+    }
+
+    /// The box grown on every side by `pad` times its diagonal plus `pad` times the largest coordinate
+    /// magnitude, so that it also grows for flat boxes and for boxes far from the origin.
+    pub fn padded(&self, pad: f32) -> Self {
+        let mag = self.min.abs().max(self.max.abs()).max_element();
+        let d = pad * (self.diagonal() + mag) + f32::MIN_POSITIVE;
+        Self {
+            min: self.min - Vec3::splat(d),
+            max: self.max + Vec3::splat(d),
+        }
+    }
+
+    /// The parametric interval `[t0, t1]` in which the ray `origin + t * dir` (given by its inverse direction)
+    /// is inside the box, clipped to `[tmin, tmax]`; `None` when the ray misses.
+    ///
+    /// NaN from `0 * inf` (a direction component of zero with the origin on a slab plane) is ignored by the
+    /// `min`/`max` forms used here, which treats the ray as inside that slab.
+    pub fn clip_ray(
+        &self,
+        origin: Vec3,
+        inv_dir: Vec3,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<(f32, f32)> {
+        let ta = (self.min - origin) * inv_dir;
+        let tb = (self.max - origin) * inv_dir;
+        let mut t0 = tmin;
+        let mut t1 = tmax;
+        for k in 0..3 {
+            let (lo, hi) = if ta[k] <= tb[k] {
+                (ta[k], tb[k])
+            } else {
+                (tb[k], ta[k])
+            };
+            t0 = t0.max(lo);
+            t1 = t1.min(hi);
+        }
+        (t0 <= t1).then_some((t0, t1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn surface_area_and_union() {
+        let a = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(a.surface_area(), 2.0 * (2.0 + 6.0 + 3.0));
+        assert_eq!(Aabb::EMPTY.surface_area(), 0.0);
+        let b = Aabb::EMPTY.union(a);
+        assert_eq!(a, b);
+        assert!(Aabb::EMPTY.is_empty());
+        assert_eq!(a.longest_axis(), 2);
+    }
+
+    #[test]
+    fn clip_ray_handles_axis_parallel_rays() {
+        let b = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let inv = Vec3::new(1.0, f32::INFINITY, f32::INFINITY);
+        // Origin on the y = 0 slab plane with a zero y direction: 0 * inf is NaN, treated as inside.
+        let r = b.clip_ray(Vec3::new(-1.0, 0.0, 0.5), inv, 0.0, f32::INFINITY);
+        assert_eq!(r, Some((1.0, 2.0)));
+        // Outside the y slab: miss.
+        assert_eq!(
+            b.clip_ray(Vec3::new(-1.0, 2.0, 0.5), inv, 0.0, f32::INFINITY),
+            None
+        );
+    }
+}

@@ -1,0 +1,432 @@
+//! SAH kd-tree construction with perfect splits in O(N log N) (Tsakok 2008, sections 2.2.1 and 3.2.1;
+//! Wald and Havran 2006, "On building fast kd-Trees for Ray Tracing, and on doing that in O(N log N)").
+//!
+//! Every triangle contributes, per axis, a start and an end event at the bounds of its part inside the node
+//! (a single "planar" event when that part is flat along the axis). The three event lists are sorted once at
+//! the root. A node sweeps each list to evaluate the SAH at every candidate plane, then classifies its
+//! triangles as left, right or both. Left-only and right-only events keep their order when copied to the
+//! children; only the straddling triangles are clipped to the child boxes ("perfect splits"), and their few
+//! new events are sorted and merged in. No list is ever sorted again, hence O(N log N).
+//!
+//! The build is iterative with an explicit stack; nodes with many triangles hand their two children to
+//! rayon tasks, whose subtrees are then spliced into one array with children kept adjacent.
+
+use glam::Vec3;
+
+use super::clip::clipped_bounds;
+use super::params::{KdParams, SplitStrategy};
+use crate::aabb::Aabb;
+
+/// A node of the builder's tree. Children of an inner node are adjacent: `left` and `left + 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum BuildNode {
+    Inner { axis: u8, split: f32, left: u32 },
+    Leaf { first: u32, count: u32 },
+}
+
+/// The builder's result: nodes (root first) and the leaves' triangle ids.
+#[derive(Debug, Default)]
+pub(super) struct BuildOutput {
+    pub nodes: Vec<BuildNode>,
+    pub tri_ids: Vec<u32>,
+}
+
+const END: u32 = 0;
+const PLANAR: u32 = 1;
+const START: u32 = 2;
+const LEFT: u8 = 0;
+const RIGHT: u8 = 1;
+const BOTH: u8 = 2;
+
+/// A split-candidate event: a plane position on one axis and the triangle it belongs to.
+#[derive(Clone, Copy, Debug)]
+struct Event {
+    pos: f32,
+    /// `tri << 2 | kind`.
+    packed: u32,
+}
+
+impl Event {
+    fn new(pos: f32, tri: u32, kind: u32) -> Self {
+        // `+ 0.0` turns -0.0 into +0.0 so that equal positions sort together.
+        Self {
+            pos: pos + 0.0,
+            packed: (tri << 2) | kind,
+        }
+    }
+    fn tri(self) -> usize {
+        (self.packed >> 2) as usize
+    }
+    fn kind(self) -> u32 {
+        self.packed & 3
+    }
+    /// Sort key: position, then end < planar < start, as the sweep expects.
+    fn key(self) -> u64 {
+        let b = self.pos.to_bits();
+        let ordered = if b >> 31 == 1 { !b } else { b | 0x8000_0000 };
+        ((ordered as u64) << 2) | self.kind() as u64
+    }
+}
+
+type Events = [Vec<Event>; 3];
+
+struct Task {
+    bounds: Aabb,
+    events: Events,
+    n: usize,
+    depth: u32,
+}
+
+struct Split {
+    axis: usize,
+    pos: f32,
+    planar_left: bool,
+}
+
+struct Ctx<'a> {
+    tris: &'a [[Vec3; 3]],
+    params: &'a KdParams,
+    max_depth: u32,
+}
+
+/// Builds the tree over `tris` inside `bounds` (which must hold every triangle).
+pub(super) fn build(tris: &[[Vec3; 3]], bounds: Aabb, params: &KdParams) -> BuildOutput {
+    let ctx = Ctx {
+        tris,
+        params,
+        max_depth: params.depth_for(tris.len()),
+    };
+    let mut events: Events = Default::default();
+    for (a, list) in events.iter_mut().enumerate() {
+        list.reserve(2 * tris.len());
+        for (i, t) in tris.iter().enumerate() {
+            let b = Aabb::from_points(t.iter().copied());
+            push_events(list, a, i as u32, &b);
+        }
+    }
+    rayon::scope(|_| {
+        events
+            .iter_mut()
+            .for_each(|l| l.sort_unstable_by_key(|e| e.key()));
+    });
+    build_parallel(
+        &ctx,
+        Task {
+            bounds,
+            events,
+            n: tris.len(),
+            depth: 0,
+        },
+    )
+}
+
+fn push_events(list: &mut Vec<Event>, axis: usize, tri: u32, b: &Aabb) {
+    if b.min[axis] == b.max[axis] {
+        list.push(Event::new(b.min[axis], tri, PLANAR));
+    } else {
+        list.push(Event::new(b.min[axis], tri, START));
+        list.push(Event::new(b.max[axis], tri, END));
+    }
+}
+
+/// Splits large nodes here and builds their children in parallel; small ones go to [`build_sequential`].
+fn build_parallel(ctx: &Ctx, task: Task) -> BuildOutput {
+    if task.n < ctx.params.parallel_min_tris {
+        return build_sequential(ctx, task);
+    }
+    let Some(split) = find_split(ctx, &task) else {
+        return build_sequential(ctx, task);
+    };
+    let mut side = vec![0u8; ctx.tris.len()];
+    let axis = split.axis as u8;
+    let pos = split.pos;
+    let (l, r) = partition(ctx, task, &split, &mut side);
+    drop(side);
+    let (lo, ro) = rayon::join(|| build_parallel(ctx, l), || build_parallel(ctx, r));
+    splice(axis, pos, lo, ro)
+}
+
+/// Joins two subtrees under a new root: `[root, left root, right root, left rest.., right rest..]`.
+fn splice(axis: u8, split: f32, lo: BuildOutput, ro: BuildOutput) -> BuildOutput {
+    let mut nodes = Vec::with_capacity(1 + lo.nodes.len() + ro.nodes.len());
+    nodes.push(BuildNode::Inner {
+        axis,
+        split,
+        left: 1,
+    });
+    let lo_rest = 3;
+    let ro_rest = lo_rest + lo.nodes.len() as u32 - 1;
+    let map = |i: u32, root: u32, rest: u32| if i == 0 { root } else { rest + i - 1 };
+    let relocate = |n: BuildNode, root: u32, rest: u32, tri_base: u32| match n {
+        BuildNode::Inner { axis, split, left } => BuildNode::Inner {
+            axis,
+            split,
+            left: map(left, root, rest),
+        },
+        BuildNode::Leaf { first, count } => BuildNode::Leaf {
+            first: first + tri_base,
+            count,
+        },
+    };
+    let tri_base = lo.tri_ids.len() as u32;
+    nodes.push(relocate(lo.nodes[0], 1, lo_rest, 0));
+    nodes.push(relocate(ro.nodes[0], 2, ro_rest, tri_base));
+    nodes.extend(lo.nodes[1..].iter().map(|&n| relocate(n, 1, lo_rest, 0)));
+    nodes.extend(
+        ro.nodes[1..]
+            .iter()
+            .map(|&n| relocate(n, 2, ro_rest, tri_base)),
+    );
+    let mut tri_ids = lo.tri_ids;
+    tri_ids.extend_from_slice(&ro.tri_ids);
+    BuildOutput { nodes, tri_ids }
+}
+
+/// Builds a subtree depth-first with an explicit stack.
+fn build_sequential(ctx: &Ctx, root: Task) -> BuildOutput {
+    let mut out = BuildOutput {
+        nodes: vec![BuildNode::Leaf { first: 0, count: 0 }],
+        tri_ids: Vec::new(),
+    };
+    let mut side = vec![0u8; ctx.tris.len()];
+    let mut stack = vec![(0usize, root)];
+    while let Some((idx, task)) = stack.pop() {
+        match find_split(ctx, &task) {
+            None => {
+                let first = out.tri_ids.len() as u32;
+                out.tri_ids.extend(
+                    task.events[0]
+                        .iter()
+                        .filter(|e| e.kind() != END)
+                        .map(|e| e.tri() as u32),
+                );
+                out.nodes[idx] = BuildNode::Leaf {
+                    first,
+                    count: task.n as u32,
+                };
+            }
+            Some(split) => {
+                let left = out.nodes.len();
+                out.nodes.push(BuildNode::Leaf { first: 0, count: 0 });
+                out.nodes.push(BuildNode::Leaf { first: 0, count: 0 });
+                out.nodes[idx] = BuildNode::Inner {
+                    axis: split.axis as u8,
+                    split: split.pos,
+                    left: left as u32,
+                };
+                let (l, r) = partition(ctx, task, &split, &mut side);
+                stack.push((left + 1, r));
+                stack.push((left, l));
+            }
+        }
+    }
+    out
+}
+
+/// The SAH cost of splitting `b` at `pos` on `axis` with `nl` and `nr` triangles on the two sides.
+fn split_cost(
+    p: &KdParams,
+    b: &Aabb,
+    inv_sa: f32,
+    axis: usize,
+    pos: f32,
+    nl: usize,
+    nr: usize,
+) -> f32 {
+    let e = b.extent();
+    let (e1, e2) = (e[(axis + 1) % 3], e[(axis + 2) % 3]);
+    let cap = e1 * e2;
+    let ring = e1 + e2;
+    let sa_l = 2.0 * (cap + (pos - b.min[axis]) * ring);
+    let sa_r = 2.0 * (cap + (b.max[axis] - pos) * ring);
+    let cost = p.c_trav + p.c_isect * (sa_l * nl as f32 + sa_r * nr as f32) * inv_sa;
+    if nl == 0 || nr == 0 {
+        cost * (1.0 - p.empty_bonus)
+    } else {
+        cost
+    }
+}
+
+/// The best split of the node, or `None` when it should be a leaf.
+fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
+    let p = ctx.params;
+    if task.n == 0 || task.depth >= ctx.max_depth {
+        return None;
+    }
+    let b = &task.bounds;
+    let sa = b.surface_area();
+    if !(sa > 0.0) {
+        return None;
+    }
+    let inv_sa = 1.0 / sa;
+    let mut best_cost = p.c_isect * task.n as f32;
+    let mut best = None;
+    let mut consider = |axis: usize, pos: f32, nl: usize, np: usize, nr: usize| {
+        for (planar_left, l, r) in [(true, nl + np, nr), (false, nl, nr + np)] {
+            let c = split_cost(p, b, inv_sa, axis, pos, l, r);
+            if c < best_cost {
+                best_cost = c;
+                best = Some(Split {
+                    axis,
+                    pos,
+                    planar_left,
+                });
+            }
+        }
+    };
+    match p.strategy {
+        SplitStrategy::Sah => {
+            for axis in 0..3 {
+                let (lo, hi) = (b.min[axis], b.max[axis]);
+                if !(hi > lo) {
+                    continue;
+                }
+                let ev = &task.events[axis];
+                let (mut nl, mut nr) = (0usize, task.n);
+                let mut i = 0;
+                while i < ev.len() {
+                    let pos = ev[i].pos;
+                    let mut count = [0usize; 3];
+                    for kind in [END, PLANAR, START] {
+                        while i < ev.len() && ev[i].pos == pos && ev[i].kind() == kind {
+                            count[kind as usize] += 1;
+                            i += 1;
+                        }
+                    }
+                    let (ne, np, ns) = (
+                        count[END as usize],
+                        count[PLANAR as usize],
+                        count[START as usize],
+                    );
+                    nr -= ne + np;
+                    if pos > lo && pos < hi {
+                        consider(axis, pos, nl, np, nr);
+                    }
+                    nl += ns + np;
+                }
+            }
+        }
+        SplitStrategy::Middle => {
+            let axis = b.longest_axis();
+            let pos = b.center()[axis];
+            if pos > b.min[axis] && pos < b.max[axis] {
+                let (mut nl, mut np, mut nr) = (0, 0, 0);
+                for e in &task.events[axis] {
+                    match e.kind() {
+                        START if e.pos < pos => nl += 1,
+                        END if e.pos > pos => nr += 1,
+                        PLANAR if e.pos < pos => nl += 1,
+                        PLANAR if e.pos > pos => nr += 1,
+                        PLANAR => np += 1,
+                        _ => {}
+                    }
+                }
+                consider(axis, pos, nl, np, nr);
+            }
+        }
+    }
+    best
+}
+
+/// Distributes the node's events to its children (Wald and Havran 2006, section 4.3).
+fn partition(ctx: &Ctx, task: Task, split: &Split, side: &mut [u8]) -> (Task, Task) {
+    let (axis, pos) = (split.axis, split.pos);
+    for e in &task.events[axis] {
+        if e.kind() != END {
+            side[e.tri()] = BOTH;
+        }
+    }
+    for e in &task.events[axis] {
+        let s = &mut side[e.tri()];
+        match e.kind() {
+            END if e.pos <= pos => *s = LEFT,
+            START if e.pos >= pos => *s = RIGHT,
+            PLANAR if e.pos < pos || (e.pos == pos && split.planar_left) => *s = LEFT,
+            PLANAR => *s = RIGHT,
+            _ => {}
+        }
+    }
+    let (mut lb, mut rb) = (task.bounds, task.bounds);
+    lb.max[axis] = pos;
+    rb.min[axis] = pos;
+
+    let mut straddlers = Vec::new();
+    let (mut nl, mut nr) = (0, 0);
+    for e in task.events[axis].iter().filter(|e| e.kind() != END) {
+        match side[e.tri()] {
+            LEFT => nl += 1,
+            RIGHT => nr += 1,
+            _ => straddlers.push(e.tri() as u32),
+        }
+    }
+    let mut new_l: Events = Default::default();
+    let mut new_r: Events = Default::default();
+    for &t in &straddlers {
+        let tri = &ctx.tris[t as usize];
+        if let Some(b) = clipped_bounds(tri, &lb) {
+            nl += 1;
+            for (a, list) in new_l.iter_mut().enumerate() {
+                push_events(list, a, t, &b);
+            }
+        }
+        if let Some(b) = clipped_bounds(tri, &rb) {
+            nr += 1;
+            for (a, list) in new_r.iter_mut().enumerate() {
+                push_events(list, a, t, &b);
+            }
+        }
+    }
+    let mut left: Events = Default::default();
+    let mut right: Events = Default::default();
+    for a in 0..3 {
+        let old = &task.events[a];
+        let (mut ol, mut or) = (Vec::with_capacity(old.len()), Vec::with_capacity(old.len()));
+        for &e in old {
+            match side[e.tri()] {
+                LEFT => ol.push(e),
+                RIGHT => or.push(e),
+                _ => {}
+            }
+        }
+        new_l[a].sort_unstable_by_key(|e| e.key());
+        new_r[a].sort_unstable_by_key(|e| e.key());
+        left[a] = merge(ol, &new_l[a]);
+        right[a] = merge(or, &new_r[a]);
+    }
+    let depth = task.depth + 1;
+    (
+        Task {
+            bounds: lb,
+            events: left,
+            n: nl,
+            depth,
+        },
+        Task {
+            bounds: rb,
+            events: right,
+            n: nr,
+            depth,
+        },
+    )
+}
+
+/// Merges two lists sorted by [`Event::key`].
+fn merge(a: Vec<Event>, b: &[Event]) -> Vec<Event> {
+    if b.is_empty() {
+        return a;
+    }
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        if a[i].key() <= b[j].key() {
+            out.push(a[i]);
+            i += 1;
+        } else {
+            out.push(b[j]);
+            j += 1;
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
+    out
+}

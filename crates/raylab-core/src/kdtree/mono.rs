@@ -1,0 +1,158 @@
+//! Single-ray ("mono") kd-tree traversal (Tsakok 2008, Listing 2.2).
+//!
+//! Iterative, with an explicit stack of `(node, t_near, t_far)` entries and the inverse direction computed
+//! once per ray. The near child is chosen by the direction's sign on the split axis; a split distance past
+//! the interval visits only the near child, one before it only the far child. Both are visited when the
+//! plane cuts the interval, and also when the distance is NaN (origin on the plane with a zero direction
+//! component: the ray runs inside the plane, and triangles of either child may touch it). Leaves come front
+//! to back, so the closest-hit search stops at the first leaf whose interval ends beyond its best hit.
+
+use std::ops::Range;
+
+use crate::ray::{Hit, Ray};
+use crate::stats::TraversalStats;
+use crate::triangle::RayShear;
+
+use super::{KdParams, KdTree};
+
+/// What a leaf visitor tells the traversal.
+enum Next {
+    /// Keep going; entries that start beyond the given distance can be skipped.
+    Continue(f32),
+    /// Stop the traversal.
+    Stop,
+}
+
+#[derive(Clone, Copy, Default)]
+struct Entry {
+    node: u32,
+    t_near: f32,
+    t_far: f32,
+}
+
+const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
+
+impl KdTree {
+    /// The closest hit along `ray` in `(tmin, tmax]`, traced alone.
+    pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        let shear = RayShear::new(ray);
+        let mut best: Option<Hit> = None;
+        let mut best_t = ray.tmax;
+        let mut tests = 0u64;
+        self.traverse(ray, stats, |ids, _t_near, t_far| {
+            for &id in &self.tri_ids()[ids] {
+                tests += 1;
+                if let Some(h) = shear.intersect(self.triangles().get(id), ray.tmin, best_t) {
+                    best_t = h.t;
+                    best = Some(Hit {
+                        t: h.t,
+                        tri: id,
+                        u: h.u,
+                        v: h.v,
+                    });
+                }
+            }
+            if best.is_some() && best_t <= t_far {
+                Next::Stop
+            } else {
+                Next::Continue(best_t)
+            }
+        });
+        stats.isect_tests += tests;
+        best
+    }
+
+    /// True when anything blocks `ray` in `(tmin, tmax]`; stops at the first blocker found.
+    pub fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        let shear = RayShear::new(ray);
+        let mut hit = false;
+        let mut tests = 0u64;
+        self.traverse(ray, stats, |ids, _, _| {
+            for &id in &self.tri_ids()[ids] {
+                tests += 1;
+                if shear
+                    .intersect(self.triangles().get(id), ray.tmin, ray.tmax)
+                    .is_some()
+                {
+                    hit = true;
+                    return Next::Stop;
+                }
+            }
+            Next::Continue(ray.tmax)
+        });
+        stats.isect_tests += tests;
+        hit
+    }
+
+    /// Walks the leaves that `ray` crosses, front to back, calling `leaf(ids, t_near, t_far)` for each.
+    #[inline(always)]
+    fn traverse(
+        &self,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+        mut leaf: impl FnMut(Range<usize>, f32, f32) -> Next,
+    ) {
+        stats.rays += 1;
+        if self.triangles().is_empty() || !ray.is_valid() {
+            return;
+        }
+        let inv = ray.inv_dir();
+        let Some((mut t_near, mut t_far)) =
+            self.bounds().clip_ray(ray.origin, inv, ray.tmin, ray.tmax)
+        else {
+            return;
+        };
+        let origin = ray.origin.to_array();
+        let inv = inv.to_array();
+        // Bit k is set when the direction is negative on axis k; then the right child is the near one.
+        let neg = inv.iter().enumerate().fold(0usize, |m, (k, v)| {
+            m | ((v.is_sign_negative() as usize) << k)
+        });
+        let nodes = self.nodes();
+        let mut stack = [Entry::default(); STACK];
+        let mut sp = 0usize;
+        let mut node = 0usize;
+        let (mut visited, mut leaves) = (0u64, 0u64);
+        loop {
+            let n = nodes[node];
+            visited += 1;
+            if !n.is_leaf() {
+                let axis = n.axis();
+                let t_split = (n.split() - origin[axis]) * inv[axis];
+                let near = n.left() | ((neg >> axis) & 1);
+                let far = near ^ 1;
+                if t_split > t_far {
+                    node = near;
+                } else if t_split < t_near {
+                    node = far;
+                } else {
+                    stack[sp] = Entry {
+                        node: far as u32,
+                        t_near: t_split.max(t_near),
+                        t_far,
+                    };
+                    sp += 1;
+                    t_far = t_split.min(t_far);
+                    node = near;
+                }
+                continue;
+            }
+            leaves += 1;
+            let limit = match leaf(n.leaf_range(), t_near, t_far) {
+                Next::Stop => break,
+                Next::Continue(limit) => limit,
+            };
+            if sp == 0 {
+                break;
+            }
+            sp -= 1;
+            let e = stack[sp];
+            if e.t_near > limit {
+                break;
+            }
+            (node, t_near, t_far) = (e.node as usize, e.t_near, e.t_far);
+        }
+        stats.nodes += visited;
+        stats.leaves += leaves;
+    }
+}

@@ -1,0 +1,80 @@
+//! Traversal methods selectable by name, behind one interface.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::kdtree::KdTree;
+use crate::ray::{Hit, Ray};
+use crate::reference::BruteForce;
+use crate::stats::TraversalStats;
+
+/// A way of tracing rays; the CLI's `--method` and the viewer's method list.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// One ray at a time through the kd-tree (thesis Listing 2.2).
+    #[default]
+    Mono,
+    /// Every ray against every triangle; for testing only.
+    Reference,
+}
+
+impl Method {
+    /// All methods, in the order menus list them.
+    pub const ALL: [Method; 2] = [Method::Mono, Method::Reference];
+
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Mono => "mono",
+            Method::Reference => "reference",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
+                format!("unknown method '{s}' (valid: {})", names.join(", "))
+            })
+    }
+}
+
+/// Closest-hit and any-hit queries on single rays, implemented by every acceleration structure.
+pub trait Intersector: Sync {
+    /// The closest hit in `(tmin, tmax]`.
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit>;
+    /// True when anything blocks the ray in `(tmin, tmax]`.
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool;
+}
+
+impl Intersector for KdTree {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        KdTree::intersect(self, ray, stats)
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        KdTree::occluded(self, ray, stats)
+    }
+}
+
+impl Intersector for BruteForce {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        BruteForce::intersect(self, ray, stats)
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        BruteForce::occluded(self, ray, stats)
+    }
+}

@@ -1,0 +1,72 @@
+//! The brute-force reference: every ray against every triangle.
+//!
+//! Slow by design and obviously correct; every traversal method is tested against it ("always keep a
+//! reference implementation", Akenine-Moller and Assarsson, Ray Tracing II).
+
+use crate::ray::{Hit, Ray};
+use crate::scene::Scene;
+use crate::stats::TraversalStats;
+use crate::triangle::{RayShear, TriangleSoup};
+
+/// Brute-force intersector over a scene's triangles.
+#[derive(Clone, Debug)]
+pub struct BruteForce {
+    tris: TriangleSoup,
+}
+
+impl BruteForce {
+    /// Prepares the triangles of `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        Self {
+            tris: TriangleSoup::from_scene(scene),
+        }
+    }
+
+    /// The closest hit in `(tmin, tmax]`; among hits at the same distance the lowest triangle id wins.
+    pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        stats.rays += 1;
+        if !ray.is_valid() {
+            return None;
+        }
+        let shear = RayShear::new(ray);
+        let mut best: Option<Hit> = None;
+        for (i, tri) in self.tris.as_slice().iter().enumerate() {
+            let tmax = best.map_or(ray.tmax, |b| b.t);
+            if let Some(h) = shear.intersect(tri, ray.tmin, tmax)
+                && best.is_none_or(|b| h.t < b.t)
+            {
+                best = Some(Hit {
+                    t: h.t,
+                    tri: i as u32,
+                    u: h.u,
+                    v: h.v,
+                });
+            }
+        }
+        stats.isect_tests += self.tris.len() as u64;
+        best
+    }
+
+    /// True when any triangle blocks the ray in `(tmin, tmax]`.
+    pub fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        stats.rays += 1;
+        if !ray.is_valid() {
+            return false;
+        }
+        let shear = RayShear::new(ray);
+        stats.isect_tests += self.tris.len() as u64;
+        self.tris
+            .as_slice()
+            .iter()
+            .any(|t| shear.intersect(t, ray.tmin, ray.tmax).is_some())
+    }
+
+    /// The distance at which `ray` hits triangle `tri`, if it does (used to check that two methods that
+    /// report different triangles at the same distance both report a real hit).
+    pub fn hit_distance(&self, ray: &Ray, tri: u32) -> Option<f32> {
+        let t = self.tris.as_slice().get(tri as usize)?;
+        RayShear::new(ray)
+            .intersect(t, ray.tmin, ray.tmax)
+            .map(|h| h.t)
+    }
+}

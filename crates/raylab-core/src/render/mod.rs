@@ -1,0 +1,124 @@
+//! The tile renderer: the image is cut into square tiles that rayon threads take in turn (thesis chapter 6),
+//! each traced in the chosen [`RayOrder`] and shaded with [`shade`].
+
+mod order;
+pub mod shade;
+
+pub use order::RayOrder;
+
+use glam::Vec3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::method::Intersector;
+use crate::scene::{Camera, PointLight, Scene};
+use crate::stats::TraversalStats;
+use shade::{ShadeContext, to_display};
+
+/// Options of one rendered frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RenderSettings {
+    /// Image width in pixels (at least 1).
+    pub width: u32,
+    /// Image height in pixels (at least 1).
+    pub height: u32,
+    /// Tile edge in pixels.
+    pub tile: u32,
+    /// Pixel order inside a tile.
+    pub order: RayOrder,
+    /// Trace hard shadows.
+    pub shadows: bool,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 512,
+            height: 512,
+            tile: 16,
+            order: RayOrder::Scanline,
+            shadows: true,
+        }
+    }
+}
+
+/// A rendered image and the work it took.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Display-ready RGBA8 pixels (gamma 2.2), row-major from the top left.
+    pub rgba: Vec<[u8; 4]>,
+    /// Counters of primary and shadow rays together.
+    pub stats: TraversalStats,
+}
+
+/// Renders `scene` from `camera` lit by `light`, tracing with `tracer`. The work runs on the current rayon
+/// pool (install a pool to choose the thread count).
+pub fn render(
+    scene: &Scene,
+    tracer: &dyn Intersector,
+    camera: &Camera,
+    light: PointLight,
+    settings: &RenderSettings,
+) -> Frame {
+    let (w, h) = (settings.width.max(1), settings.height.max(1));
+    let tile = settings.tile.max(1);
+    let raster = camera.raster(w, h);
+    let bounds = scene.bounds();
+    let epsilon = if bounds.is_empty() {
+        0.0
+    } else {
+        1e-4 * bounds.diagonal()
+    };
+    let ctx = ShadeContext {
+        scene,
+        tracer,
+        light,
+        shadows: settings.shadows,
+        epsilon,
+    };
+    let offsets = settings.order.offsets(tile, tile);
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(tile))
+        .flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile)))
+        .collect();
+    let done: Vec<(Vec<(u32, [u8; 4])>, TraversalStats)> = tiles
+        .par_iter()
+        .map(|&(x0, y0)| {
+            let mut stats = TraversalStats::default();
+            let mut px = Vec::with_capacity(offsets.len());
+            for &(dx, dy) in &offsets {
+                let (x, y) = (x0 + dx, y0 + dy);
+                if x >= w || y >= h {
+                    continue;
+                }
+                let ray = raster.primary(x, y);
+                let c = match tracer.intersect(&ray, &mut stats) {
+                    Some(hit) => ctx.shade(&ray, &hit, &mut stats),
+                    None => Vec3::ZERO,
+                };
+                px.push((
+                    y * w + x,
+                    [to_display(c.x), to_display(c.y), to_display(c.z), 255],
+                ));
+            }
+            (px, stats)
+        })
+        .collect();
+    let mut rgba = vec![[0, 0, 0, 255]; (w * h) as usize];
+    let mut stats = TraversalStats::default();
+    for (px, s) in done {
+        for (i, c) in px {
+            rgba[i as usize] = c;
+        }
+        stats += s;
+    }
+    Frame {
+        width: w,
+        height: h,
+        rgba,
+        stats,
+    }
+}

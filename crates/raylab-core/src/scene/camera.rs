@@ -1,0 +1,189 @@
+//! The pinhole camera and the exact ray convention shared with the Embree harness.
+
+use glam::{DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::ray::Ray;
+
+/// A camera looking from `eye` toward `target`, with a vertical field of view, and a thin lens (aperture
+/// radius and focus distance) for depth of field; an aperture of zero is a pinhole.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    /// Eye position.
+    pub eye: Vec3,
+    /// Point looked at.
+    pub target: Vec3,
+    /// Up hint (need not be orthogonal to the view direction).
+    pub up: Vec3,
+    /// Vertical field of view in degrees.
+    pub vfov_deg: f32,
+    /// Lens radius; 0 gives a pinhole camera.
+    pub aperture: f32,
+    /// Distance to the plane in focus.
+    pub focus_distance: f32,
+}
+
+/// A named viewpoint that a scene carries.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct View {
+    /// Name shown in the UI and accepted by `--view`.
+    pub name: String,
+    /// The camera.
+    pub camera: Camera,
+}
+
+/// Why a camera cannot produce rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraError {
+    /// A coordinate or the field of view is NaN or infinite.
+    NotFinite,
+    /// `eye` equals `target`.
+    NoViewDirection,
+    /// `up` is parallel to the view direction (or zero).
+    UpParallel,
+    /// The field of view is outside (0, 180) degrees.
+    Fov,
+}
+
+impl std::fmt::Display for CameraError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::NotFinite => "camera values must be finite",
+            Self::NoViewDirection => "eye and target must differ",
+            Self::UpParallel => "up must not be parallel to the view direction",
+            Self::Fov => "field of view must be in (0, 180) degrees",
+        })
+    }
+}
+
+impl std::error::Error for CameraError {}
+
+impl Camera {
+    /// A pinhole camera.
+    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, vfov_deg: f32) -> Self {
+        let focus_distance = (target - eye).length().max(1e-3);
+        Self {
+            eye,
+            target,
+            up,
+            vfov_deg,
+            aperture: 0.0,
+            focus_distance,
+        }
+    }
+
+    /// Checks that the camera defines a proper basis.
+    pub fn validate(&self) -> Result<(), CameraError> {
+        let vals = [self.eye, self.target, self.up];
+        if vals.iter().any(|v| !v.is_finite()) || !self.vfov_deg.is_finite() {
+            return Err(CameraError::NotFinite);
+        }
+        if !(self.vfov_deg > 0.0 && self.vfov_deg < 180.0) {
+            return Err(CameraError::Fov);
+        }
+        let f = self.target.as_dvec3() - self.eye.as_dvec3();
+        if f.length_squared() == 0.0 {
+            return Err(CameraError::NoViewDirection);
+        }
+        if f.normalize().cross(self.up.as_dvec3()).length_squared() < 1e-18 {
+            return Err(CameraError::UpParallel);
+        }
+        Ok(())
+    }
+
+    /// Precomputes the per-image constants of the ray convention for a `width x height` image.
+    pub fn raster(&self, width: u32, height: u32) -> CameraRaster {
+        let f = (self.target.as_dvec3() - self.eye.as_dvec3()).normalize();
+        let r = f.cross(self.up.as_dvec3()).normalize();
+        let u = r.cross(f);
+        let s = (self.vfov_deg as f64 * std::f64::consts::PI / 360.0).tan();
+        let aspect = width as f64 / height as f64;
+        CameraRaster {
+            eye: self.eye,
+            f,
+            r: r * (s * aspect),
+            u: u * s,
+            width: width as f64,
+            height: height as f64,
+        }
+    }
+}
+
+/// A camera prepared for one image size.
+///
+/// The convention is the Embree harness's (`shared/tools/embree-bench/README.md`, "Camera"): all math in
+/// double precision, pixel (0, 0) at the top left, `d = normalize(f + (2(x+0.5)/W - 1) s a r -
+/// (2(y+0.5)/H - 1) s u)`, rounded to `f32` only at the end, so both tracers see bit-identical rays.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRaster {
+    eye: Vec3,
+    f: DVec3,
+    r: DVec3,
+    u: DVec3,
+    width: f64,
+    height: f64,
+}
+
+impl CameraRaster {
+    /// The primary ray through the centre of pixel `(x, y)`.
+    pub fn primary(&self, x: u32, y: u32) -> Ray {
+        self.primary_at(x as f64 + 0.5, y as f64 + 0.5)
+    }
+
+    /// The primary ray through the continuous raster position `(px, py)` (pixel centres at `+0.5`).
+    pub fn primary_at(&self, px: f64, py: f64) -> Ray {
+        let sx = 2.0 * px / self.width - 1.0;
+        let sy = 2.0 * py / self.height - 1.0;
+        let d = (self.f + sx * self.r - sy * self.u).normalize();
+        Ray::new(self.eye, d.as_vec3())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn centre_ray_looks_at_target() {
+        let cam = Camera::look_at(Vec3::ZERO, Vec3::new(0.0, 0.0, -5.0), Vec3::Y, 60.0);
+        let r = cam.raster(2, 2).primary_at(1.0, 1.0);
+        assert!((r.dir - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-7);
+        // Top-left pixel looks up and to the left.
+        let tl = cam.raster(2, 2).primary(0, 0);
+        assert!(tl.dir.x < 0.0 && tl.dir.y > 0.0);
+    }
+
+    #[test]
+    fn validate_rejects_bad_cameras() {
+        let ok = Camera::look_at(Vec3::ZERO, Vec3::X, Vec3::Y, 60.0);
+        assert_eq!(ok.validate(), Ok(()));
+        assert_eq!(
+            Camera {
+                vfov_deg: 180.0,
+                ..ok
+            }
+            .validate(),
+            Err(CameraError::Fov)
+        );
+        assert_eq!(
+            Camera {
+                target: Vec3::ZERO,
+                ..ok
+            }
+            .validate(),
+            Err(CameraError::NoViewDirection)
+        );
+        assert_eq!(
+            Camera { up: Vec3::X, ..ok }.validate(),
+            Err(CameraError::UpParallel)
+        );
+        assert_eq!(
+            Camera {
+                eye: Vec3::NAN,
+                ..ok
+            }
+            .validate(),
+            Err(CameraError::NotFinite)
+        );
+    }
+}

@@ -1,0 +1,79 @@
+//! Traversal counters, defined as in the thesis tables (Tsakok 2008, Tables 4.1-4.6).
+//!
+//! A kernel bumps plain local integers and adds them to a [`TraversalStats`] once per ray, packet or tile;
+//! tiles merge with `+=`. No atomics are touched per node.
+
+use std::ops::AddAssign;
+
+use serde::{Deserialize, Serialize};
+
+/// Work counted while tracing.
+///
+/// `nodes` counts every kd-tree node a ray (or packet, or frustum) visits, inner nodes and leaves alike; this
+/// is the thesis's N once divided by the number of packets. `isect_tests` counts triangle tests (the thesis's
+/// I, likewise). For packet kernels one visit or one test by a whole packet counts once.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TraversalStats {
+    /// Rays traced.
+    pub rays: u64,
+    /// Nodes visited (inner nodes and leaves).
+    pub nodes: u64,
+    /// Leaves visited (included in `nodes`).
+    pub leaves: u64,
+    /// Ray/triangle intersection tests.
+    pub isect_tests: u64,
+}
+
+impl AddAssign for TraversalStats {
+    fn add_assign(&mut self, o: Self) {
+        self.rays += o.rays;
+        self.nodes += o.nodes;
+        self.leaves += o.leaves;
+        self.isect_tests += o.isect_tests;
+    }
+}
+
+impl TraversalStats {
+    /// Average nodes visited per ray (0 when no ray was traced).
+    pub fn nodes_per_ray(&self) -> f64 {
+        ratio(self.nodes, self.rays)
+    }
+
+    /// Average leaves visited per ray.
+    pub fn leaves_per_ray(&self) -> f64 {
+        ratio(self.leaves, self.rays)
+    }
+
+    /// Average triangle tests per ray.
+    pub fn isects_per_ray(&self) -> f64 {
+        ratio(self.isect_tests, self.rays)
+    }
+}
+
+fn ratio(a: u64, b: u64) -> f64 {
+    if b == 0 { 0.0 } else { a as f64 / b as f64 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merge_and_ratios() {
+        let mut a = TraversalStats {
+            rays: 2,
+            nodes: 10,
+            leaves: 4,
+            isect_tests: 6,
+        };
+        a += TraversalStats {
+            rays: 2,
+            nodes: 2,
+            leaves: 0,
+            isect_tests: 2,
+        };
+        assert_eq!(a.nodes_per_ray(), 3.0);
+        assert_eq!(a.isects_per_ray(), 2.0);
+        assert_eq!(TraversalStats::default().nodes_per_ray(), 0.0);
+    }
+}
