@@ -62,7 +62,7 @@ pub struct SceneArgs {
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees, in (0, 180).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub fov: Option<f32>,
     /// Point light position X,Y,Z (defaults to the scene's light).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -162,13 +162,13 @@ mod tests {
 #[derive(Args, Clone, Debug)]
 pub struct KdArgs {
     /// Traversal cost C_traversal of the SAH.
-    #[arg(long, default_value_t = KdParams::default().c_trav)]
+    #[arg(long, default_value_t = KdParams::default().c_trav, allow_hyphen_values = true)]
     pub kd_ctrav: f32,
     /// Intersection cost C_intersect of the SAH (the thesis uses 5 x C_traversal).
-    #[arg(long, default_value_t = KdParams::default().c_isect)]
+    #[arg(long, default_value_t = KdParams::default().c_isect, allow_hyphen_values = true)]
     pub kd_cisect: f32,
     /// Empty-space bonus in [0, 1).
-    #[arg(long, default_value_t = KdParams::default().empty_bonus)]
+    #[arg(long, default_value_t = KdParams::default().empty_bonus, allow_hyphen_values = true)]
     pub kd_empty_bonus: f32,
     /// Maximum tree depth (default: 8 + 1.3 log2 N).
     #[arg(long, value_parser = in_range(1, KdParams::DEPTH_LIMIT as u64))]

@@ -4,7 +4,7 @@
 
 pub mod builtin;
 mod error;
-mod mesh;
+pub mod mesh;
 pub mod obj_positions;
 mod source;
 

@@ -5,7 +5,8 @@
 //! the interval visits only the near child, one before it only the far child. Both are visited when the
 //! plane cuts the interval, and also when the distance is NaN (origin on the plane with a zero direction
 //! component: the ray runs inside the plane, and triangles of either child may touch it). Leaves come front
-//! to back, so the closest-hit search stops at the first leaf whose interval ends beyond its best hit.
+//! to back, so once a hit is found every stack entry that starts beyond it is skipped. Distance comparisons
+//! allow [`SPLIT_SLACK`] so that rounding never skips a cell a ray only grazes.
 
 use std::ops::Range;
 
@@ -17,7 +18,7 @@ use super::{KdParams, KdTree};
 
 /// What a leaf visitor tells the traversal.
 enum Next {
-    /// Keep going; entries that start beyond the given distance can be skipped.
+    /// Keep going; stack entries that start beyond the given distance are skipped.
     Continue(f32),
     /// Stop the traversal.
     Stop,
@@ -32,6 +33,12 @@ struct Entry {
 
 const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 
+/// Relative slack on split distances: 8 ulps. `(split - o) * inv` carries about 1.5 ulps of rounding, so
+/// two planes that the ray crosses at the same point (a cell corner, where a triangle's vertex may sit) can
+/// come out in either order; the slack makes such near-coincident crossings visit both children instead of
+/// skipping the cell between them.
+pub const SPLIT_SLACK: f32 = 8.0 * f32::EPSILON;
+
 impl KdTree {
     /// The closest hit along `ray` in `(tmin, tmax]`, traced alone.
     pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
@@ -39,7 +46,7 @@ impl KdTree {
         let mut best: Option<Hit> = None;
         let mut best_t = ray.tmax;
         let mut tests = 0u64;
-        self.traverse(ray, stats, |ids, _t_near, t_far| {
+        self.traverse(ray, stats, |ids, _, _| {
             for &id in &self.tri_ids()[ids] {
                 tests += 1;
                 if let Some(h) = shear.intersect(self.triangles().get(id), ray.tmin, best_t) {
@@ -52,11 +59,7 @@ impl KdTree {
                     });
                 }
             }
-            if best.is_some() && best_t <= t_far {
-                Next::Stop
-            } else {
-                Next::Continue(best_t)
-            }
+            Next::Continue(best_t)
         });
         stats.isect_tests += tests;
         best
@@ -113,7 +116,7 @@ impl KdTree {
         let mut sp = 0usize;
         let mut node = 0usize;
         let (mut visited, mut leaves) = (0u64, 0u64);
-        loop {
+        'walk: loop {
             let n = nodes[node];
             visited += 1;
             if !n.is_leaf() {
@@ -121,9 +124,9 @@ impl KdTree {
                 let t_split = (n.split() - origin[axis]) * inv[axis];
                 let near = n.left() | ((neg >> axis) & 1);
                 let far = near ^ 1;
-                if t_split > t_far {
+                if t_split > t_far * (1.0 + SPLIT_SLACK) {
                     node = near;
-                } else if t_split < t_near {
+                } else if t_split < t_near * (1.0 - SPLIT_SLACK) {
                     node = far;
                 } else {
                     stack[sp] = Entry {
@@ -139,18 +142,23 @@ impl KdTree {
             }
             leaves += 1;
             let limit = match leaf(n.leaf_range(), t_near, t_far) {
-                Next::Stop => break,
+                Next::Stop => break 'walk,
                 Next::Continue(limit) => limit,
             };
-            if sp == 0 {
-                break;
+            // Entries that start beyond the best hit are skipped, not a reason to stop: a ray lying in a split
+            // plane pushes a far child whose interval overlaps the near one, so one may sit deeper in the
+            // stack than entries that start later.
+            loop {
+                if sp == 0 {
+                    break 'walk;
+                }
+                sp -= 1;
+                let e = stack[sp];
+                if e.t_near * (1.0 - SPLIT_SLACK) <= limit {
+                    (node, t_near, t_far) = (e.node as usize, e.t_near, e.t_far);
+                    break;
+                }
             }
-            sp -= 1;
-            let e = stack[sp];
-            if e.t_near > limit {
-                break;
-            }
-            (node, t_near, t_far) = (e.node as usize, e.t_near, e.t_far);
         }
         stats.nodes += visited;
         stats.leaves += leaves;

@@ -196,7 +196,7 @@ fn column(m: &mut MeshBuilder, base: Vec3, height: f32, seg: u32) {
 
 /// Balusters and a hand rail across the gallery bay that starts at `x`.
 fn railing(m: &mut MeshBuilder, x: f32, z: f32, seg: u32, d: Detail) {
-    let n = d.pick(8, 2);
+    let n = d.pick(5, 2);
     let y = GALLERY_Y;
     let profile = [
         (0.0, 0.0),

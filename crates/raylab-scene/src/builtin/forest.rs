@@ -18,10 +18,10 @@ pub(super) fn build(d: Detail) -> Scene {
     let mut m = MeshBuilder::new();
     let mut rng = Jitter::new(11);
     m.material(Material::diffuse("ground", Vec3::new(0.3, 0.25, 0.15)));
-    terrain(&mut m, d.pick(120, 8));
+    terrain(&mut m, d.pick(100, 8));
 
     let trees = d.pick(60, 3);
-    let leaves = d.pick(500, 12);
+    let leaves = d.pick(300, 12);
     let bark = m.material(Material::diffuse("bark", Vec3::new(0.35, 0.22, 0.12)));
     let leaf = m.material(Material::diffuse("leaf", Vec3::new(0.2, 0.5, 0.15)));
     for _ in 0..trees {

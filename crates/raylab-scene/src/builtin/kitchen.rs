@@ -94,7 +94,7 @@ pub(super) fn build(d: Detail) -> Scene {
     let cups = d.pick(30, 2);
     let bottles = d.pick(30, 2);
     let pots = d.pick(8, 1);
-    let fruit = d.pick(30, 2);
+    let fruit = d.pick(45, 2);
     let on_surface = |rng: &mut Jitter, i: u32| {
         if i % 2 == 0 {
             Vec3::new(rng.range(-1.3, 1.3), 0.82, rng.range(-0.8, 0.8))

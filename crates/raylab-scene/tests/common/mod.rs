@@ -1,0 +1,123 @@
+//! Shared test helpers: adversarial ray sets and the comparison of a method against brute force.
+
+#![allow(dead_code)]
+
+use glam::Vec3;
+use raylab_core::kdtree::KdTree;
+use raylab_core::method::Intersector;
+use raylab_core::ray::Ray;
+use raylab_core::reference::BruteForce;
+use raylab_core::scene::Scene;
+use raylab_core::stats::TraversalStats;
+use raylab_scene::mesh::Jitter;
+
+/// Relative tolerance on hit distances between two methods that report the same triangle or distance.
+pub const T_REL_TOL: f32 = 1e-5;
+
+/// Asserts that `method` returns the same closest hit (triangle and t) and the same occlusion as brute
+/// force for every ray. Different triangles are accepted only when both are hit at the same distance.
+pub fn check_hits(scene: &Scene, method: &dyn Intersector, rays: &[Ray], what: &str) {
+    let reference = BruteForce::new(scene);
+    let mut s = TraversalStats::default();
+    for (i, ray) in rays.iter().enumerate() {
+        let want = reference.intersect(ray, &mut s);
+        let got = method.intersect(ray, &mut s);
+        match (got, want) {
+            (None, None) => {}
+            (Some(g), Some(w)) => {
+                let close = (g.t - w.t).abs() <= T_REL_TOL * w.t.abs().max(1e-30);
+                let same_tri = g.tri == w.tri;
+                let tie = close && reference.hit_distance(ray, g.tri).is_some_and(|t| t == g.t);
+                assert!(
+                    close && (same_tri || tie),
+                    "{what}: ray {i} {ray:?}: got {g:?}, reference {w:?}"
+                );
+            }
+            _ => panic!("{what}: ray {i} {ray:?}: got {got:?}, reference {want:?}"),
+        }
+        let occ_want = reference.occluded(ray, &mut s);
+        let occ_got = method.occluded(ray, &mut s);
+        assert_eq!(occ_got, occ_want, "{what}: occlusion of ray {i} {ray:?}");
+    }
+}
+
+/// A mixed set of adversarial rays for `scene`: random origins and directions; directions with one and two
+/// zero components (of both signs); rays aimed exactly at vertices and edge midpoints; rays running inside
+/// split planes of `tree`; rays grazing along triangle planes; segments with tmin > 0 and finite tmax.
+pub fn adversarial_rays(scene: &Scene, tree: &KdTree, n: usize, seed: u32) -> Vec<Ray> {
+    let mut rng = Jitter::new(seed);
+    let b = scene.bounds();
+    let pad = b.extent() * 0.2;
+    let (lo, hi) = (b.min - pad, b.max + pad);
+    let mut point = |rng: &mut Jitter| {
+        Vec3::new(
+            rng.range(lo.x, hi.x),
+            rng.range(lo.y, hi.y),
+            rng.range(lo.z, hi.z),
+        )
+    };
+    let mut rays = Vec::new();
+    let axis_dirs = [
+        Vec3::X,
+        Vec3::NEG_X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::Z,
+        Vec3::NEG_Z,
+        Vec3::new(1.0, -0.0, 0.0),
+        Vec3::new(-0.0, 0.0, -1.0),
+        Vec3::new(0.0, 0.7, -0.7),
+        Vec3::new(-0.6, 0.0, 0.8),
+        Vec3::new(0.5, -0.5, -0.0),
+    ];
+    for k in 0..n {
+        let o = point(&mut rng);
+        let random_dir = Vec3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        );
+        rays.push(Ray::new(o, random_dir));
+        rays.push(Ray::new(o, axis_dirs[k % axis_dirs.len()]));
+        if scene.triangle_count() > 0 {
+            let t = (rng.next() * scene.triangle_count() as f32) as usize % scene.triangle_count();
+            let [a, bb, c] = scene.vertices(t);
+            let targets = [
+                a,
+                bb,
+                c,
+                (a + bb) * 0.5,
+                (bb + c) * 0.5,
+                (a + c) / 3.0 + bb / 3.0 + c / 3.0,
+            ];
+            let target = targets[k % targets.len()];
+            rays.push(Ray::new(o, target - o));
+            // Grazing: start on the triangle's plane and run along it toward an edge and past a vertex.
+            rays.push(Ray::new(a, bb - a));
+            rays.push(Ray::new((a + c) * 0.5 - (bb - a), bb - a));
+            // A segment with tmin > 0 and a finite tmax around the target.
+            let d = target - o;
+            rays.push(Ray::segment(o, d, 0.5, 1.0));
+            rays.push(Ray::segment(o, d, 0.999, 1.001));
+        }
+    }
+    // Rays inside split planes with a zero direction component on the split axis.
+    let mut splits = Vec::new();
+    tree.visit(|_, _, node| {
+        if !node.is_leaf() && splits.len() < n {
+            splits.push((node.axis(), node.split()));
+        }
+    });
+    for (k, (axis, split)) in splits.into_iter().enumerate() {
+        let mut o = point(&mut rng);
+        o[axis] = split;
+        let mut d = Vec3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        );
+        d[axis] = if k % 2 == 0 { 0.0 } else { -0.0 };
+        rays.push(Ray::new(o, d));
+    }
+    rays
+}
