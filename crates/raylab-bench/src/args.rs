@@ -14,10 +14,7 @@ pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     }
     let mut v = [0f32; 3];
     for (out, p) in v.iter_mut().zip(&parts) {
-        let x: f32 = p
-            .trim()
-            .parse()
-            .map_err(|_| format!("'{p}' is not a number"))?;
+        let x: f32 = p.trim().parse().map_err(|_| format!("'{p}' is not a number"))?;
         if !x.is_finite() {
             return Err(format!("'{p}' is not finite"));
         }
@@ -27,19 +24,10 @@ pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
 }
 
 /// A clap value parser for integers in `lo..=hi`.
-pub fn in_range(
-    lo: u64,
-    hi: u64,
-) -> impl Fn(&str) -> Result<u64, String> + Clone + Send + Sync + 'static {
+pub fn in_range(lo: u64, hi: u64) -> impl Fn(&str) -> Result<u64, String> + Clone + Send + Sync + 'static {
     move |s: &str| {
-        let v: u64 = s
-            .parse()
-            .map_err(|_| format!("'{s}' is not a whole number"))?;
-        if (lo..=hi).contains(&v) {
-            Ok(v)
-        } else {
-            Err(format!("{v} is out of range {lo}..={hi}"))
-        }
+        let v: u64 = s.parse().map_err(|_| format!("'{s}' is not a whole number"))?;
+        if (lo..=hi).contains(&v) { Ok(v) } else { Err(format!("{v} is out of range {lo}..={hi}")) }
     }
 }
 
@@ -80,45 +68,19 @@ impl SceneArgs {
         let base = match &self.view {
             Some(name) => scene.view(name).map(|v| v.camera).ok_or_else(|| {
                 let names: Vec<_> = scene.views.iter().map(|v| v.name.as_str()).collect();
-                format!(
-                    "--view: no view '{name}' in this scene (views: {})",
-                    names.join(", ")
-                )
+                format!("--view: no view '{name}' in this scene (views: {})", names.join(", "))
             })?,
-            None => scene
-                .default_view()
-                .map(|v| v.camera)
-                .unwrap_or_else(|| default_camera(scene)),
+            None => scene.default_view().map(|v| v.camera).unwrap_or_else(|| default_camera(scene)),
         };
         let mut cam = base;
         cam.eye = self.eye.unwrap_or(cam.eye);
         cam.target = self.target.unwrap_or(cam.target);
-        cam.up = self
-            .up
-            .unwrap_or(if self.eye.is_some() || self.target.is_some() {
-                Vec3::Y
-            } else {
-                cam.up
-            });
-        cam.vfov_deg = self
-            .fov
-            .unwrap_or(if self.view.is_none() && self.eye.is_some() {
-                60.0
-            } else {
-                cam.vfov_deg
-            });
-        cam.validate()
-            .map_err(|e| format!("camera (--eye/--target/--up/--fov): {e}"))?;
-        let mut light = scene
-            .lights
-            .first()
-            .copied()
-            .unwrap_or_else(|| PointLight::at(default_light(scene)));
+        cam.up = self.up.unwrap_or(if self.eye.is_some() || self.target.is_some() { Vec3::Y } else { cam.up });
+        cam.vfov_deg = self.fov.unwrap_or(if self.view.is_none() && self.eye.is_some() { 60.0 } else { cam.vfov_deg });
+        cam.validate().map_err(|e| format!("camera (--eye/--target/--up/--fov): {e}"))?;
+        let mut light = scene.lights.first().copied().unwrap_or_else(|| PointLight::at(default_light(scene)));
         if let Some(p) = self.light {
-            light = PointLight {
-                position: p,
-                ..light
-            };
+            light = PointLight { position: p, ..light };
         }
         Ok((cam, light))
     }

@@ -30,11 +30,7 @@ impl Environment {
             .unwrap_or_else(|| "unknown".into());
         let cpu = std::fs::read_to_string("/proc/cpuinfo")
             .ok()
-            .and_then(|s| {
-                s.lines()
-                    .find(|l| l.starts_with("model name"))
-                    .map(|l| l.to_string())
-            })
+            .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.to_string()))
             .and_then(|l| l.split(':').nth(1).map(|s| s.trim().to_string()))
             .unwrap_or_else(|| std::env::consts::ARCH.into());
         Self {
@@ -54,11 +50,7 @@ impl Environment {
             self.rustc,
             self.cpu,
             self.cpus,
-            if self.simd.is_empty() {
-                "none".to_string()
-            } else {
-                self.simd.join(" ")
-            }
+            if self.simd.is_empty() { "none".to_string() } else { self.simd.join(" ") }
         )
     }
 }

@@ -11,11 +11,7 @@ mod timing;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(
-    name = "raylab-bench",
-    version,
-    about = "raylab's headless renderer and benchmark"
-)]
+#[command(name = "raylab-bench", version, about = "raylab's headless renderer and benchmark")]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,

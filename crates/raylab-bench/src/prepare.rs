@@ -23,8 +23,7 @@ pub fn with_spinner<T>(msg: &str, f: impl FnOnce() -> T) -> T {
 /// Loads the scene named by `source`; the error names the scene or file.
 pub fn load_scene(source: &SceneSource) -> Result<(Scene, f64), String> {
     let t0 = Instant::now();
-    let scene =
-        with_spinner("loading scene", || raylab_scene::load(source)).map_err(|e| e.to_string())?;
+    let scene = with_spinner("loading scene", || raylab_scene::load(source)).map_err(|e| e.to_string())?;
     Ok((scene, t0.elapsed().as_secs_f64()))
 }
 
@@ -34,8 +33,5 @@ pub fn build_tree(scene: &Scene, params: &KdParams, threads: usize) -> Result<Kd
         .num_threads(threads)
         .build()
         .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
-    with_spinner("building kd-tree", || {
-        pool.install(|| KdTree::build(scene, params))
-    })
-    .map_err(|e| e.to_string())
+    with_spinner("building kd-tree", || pool.install(|| KdTree::build(scene, params))).map_err(|e| e.to_string())
 }

@@ -88,12 +88,7 @@ pub fn trace_once(tracer: &dyn Intersector, w: &Workload) -> (Vec<PixelResult>, 
     (results, stats)
 }
 
-fn trace_ray(
-    tracer: &dyn Intersector,
-    ray: &Ray,
-    occlusion: bool,
-    stats: &mut TraversalStats,
-) -> PixelResult {
+fn trace_ray(tracer: &dyn Intersector, ray: &Ray, occlusion: bool, stats: &mut TraversalStats) -> PixelResult {
     if occlusion {
         PixelResult::Occluded(tracer.occluded(ray, stats))
     } else {

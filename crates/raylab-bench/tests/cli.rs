@@ -3,11 +3,7 @@
 use std::process::{Command, Output};
 
 fn bench(args: &[&str], dir: &std::path::Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raylab-bench"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("runs")
+    Command::new(env!("CARGO_BIN_EXE_raylab-bench")).args(args).current_dir(dir).output().expect("runs")
 }
 
 fn stderr(o: &Output) -> String {
@@ -19,17 +15,7 @@ fn render_writes_a_png() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("a.png");
     let o = bench(
-        &[
-            "render",
-            "--scene",
-            "arena",
-            "--width",
-            "64",
-            "--height",
-            "48",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+        &["render", "--scene", "arena", "--width", "64", "--height", "48", "--out", out.to_str().unwrap()],
         dir.path(),
     );
     assert!(o.status.success(), "{}", stderr(&o));
@@ -44,20 +30,13 @@ fn trace_json_is_one_object_with_checksums() {
     let dir = tempfile::tempdir().unwrap();
     for kind in ["primary", "shadow", "diffuse"] {
         let o = bench(
-            &[
-                "trace", "--scene", "arena", "--width", "32", "--height", "32", "--kind", kind,
-                "--reps", "2", "--json",
-            ],
+            &["trace", "--scene", "arena", "--width", "32", "--height", "32", "--kind", kind, "--reps", "2", "--json"],
             dir.path(),
         );
         assert!(o.status.success(), "{}", stderr(&o));
-        let v: serde_json::Value =
-            serde_json::from_slice(&o.stdout).expect("stdout is exactly one JSON object");
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is exactly one JSON object");
         let r = &v["result"];
-        assert!(
-            r["rays"].as_u64().unwrap() > 0 && r["mrays_median"].as_f64().unwrap() > 0.0,
-            "{v}"
-        );
+        assert!(r["rays"].as_u64().unwrap() > 0 && r["mrays_median"].as_f64().unwrap() > 0.0, "{v}");
         assert!(r["hits"].as_u64().unwrap() > 0, "{kind}: {v}");
         assert!(v["validated_rays"].as_u64().unwrap() > 0);
         assert_eq!(v["result"]["kind"], kind);
@@ -71,10 +50,7 @@ fn info_reports_tree_statistics() {
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(v["triangles"].as_u64().unwrap() > 10_000);
-    assert!(
-        v["kdtree"]["leaves"].as_u64().unwrap() > 1
-            && v["kdtree"]["sah_cost"].as_f64().unwrap() > 0.0
-    );
+    assert!(v["kdtree"]["leaves"].as_u64().unwrap() > 1 && v["kdtree"]["sah_cost"].as_f64().unwrap() > 0.0);
 }
 
 #[test]
@@ -83,78 +59,33 @@ fn bad_input_is_refused_with_a_clear_error() {
     std::fs::write(dir.path().join("broken.obj"), "v 0 0 0\nv 1 oops 0\n").unwrap();
     std::fs::write(dir.path().join("empty.obj"), "# nothing\n").unwrap();
     let cases: &[(&[&str], &str)] = &[
-        (
-            &["info", "--scene", "sponzaa"],
-            "atrium, arena, kitchen, forest",
-        ),
+        (&["info", "--scene", "sponzaa"], "atrium, arena, kitchen, forest"),
         (&["info", "--scene", "missing.obj"], "missing.obj"),
         (&["info", "--scene", "broken.obj"], "broken.obj:2"),
         (&["info", "--scene", "empty.obj"], "no usable triangles"),
-        (
-            &["info", "--scene", "model.fbx"],
-            "unsupported scene format",
-        ),
+        (&["info", "--scene", "model.fbx"], "unsupported scene format"),
         (&["render", "--scene", "arena", "--width", "0"], "1..=16384"),
-        (
-            &["render", "--scene", "arena", "--width", "99999999999"],
-            "1..=16384",
-        ),
+        (&["render", "--scene", "arena", "--width", "99999999999"], "1..=16384"),
         (&["render", "--scene", "arena", "--eye", "1,2"], "X,Y,Z"),
+        (&["render", "--scene", "arena", "--eye", "nan,0,0"], "not finite"),
+        (&["render", "--scene", "arena", "--fov", "180"], "field of view"),
+        (&["render", "--scene", "arena", "--eye", "1,1,1", "--target", "1,1,1"], "eye and target"),
+        (&["render", "--scene", "arena", "--view", "nowhere"], "overview"),
         (
-            &["render", "--scene", "arena", "--eye", "nan,0,0"],
-            "not finite",
-        ),
-        (
-            &["render", "--scene", "arena", "--fov", "180"],
-            "field of view",
-        ),
-        (
-            &[
-                "render", "--scene", "arena", "--eye", "1,1,1", "--target", "1,1,1",
-            ],
-            "eye and target",
-        ),
-        (
-            &["render", "--scene", "arena", "--view", "nowhere"],
-            "overview",
-        ),
-        (
-            &[
-                "render",
-                "--scene",
-                "arena",
-                "--out",
-                "/nonexistent-dir/x.png",
-                "--width",
-                "8",
-                "--height",
-                "8",
-            ],
+            &["render", "--scene", "arena", "--out", "/nonexistent-dir/x.png", "--width", "8", "--height", "8"],
             "cannot write",
         ),
-        (
-            &["trace", "--scene", "arena", "--kind", "glossy"],
-            "primary, shadow, diffuse",
-        ),
+        (&["trace", "--scene", "arena", "--kind", "glossy"], "primary, shadow, diffuse"),
         (&["trace", "--scene", "arena", "--method", "warp"], "mono"),
         (&["trace", "--scene", "arena", "--threads", "0"], "1..=1024"),
-        (
-            &["trace", "--scene", "arena", "--kd-cisect", "-1"],
-            "c_isect",
-        ),
-        (
-            &["trace", "--scene", "arena", "--kd-empty-bonus", "1"],
-            "empty_bonus",
-        ),
+        (&["trace", "--scene", "arena", "--kd-cisect", "-1"], "c_isect"),
+        (&["trace", "--scene", "arena", "--kd-empty-bonus", "1"], "empty_bonus"),
     ];
     for (args, needle) in cases {
         let o = bench(args, dir.path());
         assert!(!o.status.success(), "{args:?} should fail");
         let e = stderr(&o);
-        assert!(
-            e.contains(needle),
-            "{args:?}: error should mention '{needle}', got: {e}"
-        );
+        assert!(e.contains(needle), "{args:?}: error should mention '{needle}', got: {e}");
         assert!(!e.contains("panicked"), "{args:?} panicked: {e}");
     }
 }

@@ -22,10 +22,7 @@ impl Default for Aabb {
 
 impl Aabb {
     /// The empty box (contains nothing; the identity of [`Aabb::union`]).
-    pub const EMPTY: Aabb = Aabb {
-        min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
-    };
+    pub const EMPTY: Aabb = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
 
     /// The box spanning two corners.
     pub fn new(min: Vec3, max: Vec3) -> Self {
@@ -39,26 +36,17 @@ impl Aabb {
 
     /// This box grown to hold `p`.
     pub fn grow(self, p: Vec3) -> Self {
-        Self {
-            min: self.min.min(p),
-            max: self.max.max(p),
-        }
+        Self { min: self.min.min(p), max: self.max.max(p) }
     }
 
     /// The smallest box holding both boxes.
     pub fn union(self, o: Aabb) -> Self {
-        Self {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-        }
+        Self { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     /// The overlap of both boxes (possibly empty).
     pub fn intersection(self, o: Aabb) -> Self {
-        Self {
-            min: self.min.max(o.min),
-            max: self.max.min(o.max),
-        }
+        Self { min: self.min.max(o.min), max: self.max.min(o.max) }
     }
 
     /// True when the box holds no point (some `min > max`).
@@ -109,36 +97,28 @@ impl Aabb {
     pub fn padded(&self, pad: f32) -> Self {
         let mag = self.min.abs().max(self.max.abs()).max_element();
         let d = pad * (self.diagonal() + mag) + f32::MIN_POSITIVE;
-        Self {
-            min: self.min - Vec3::splat(d),
-            max: self.max + Vec3::splat(d),
-        }
+        Self { min: self.min - Vec3::splat(d), max: self.max + Vec3::splat(d) }
     }
 
     /// The parametric interval `[t0, t1]` in which the ray `origin + t * dir` (given by its inverse direction)
     /// is inside the box, clipped to `[tmin, tmax]`; `None` when the ray misses.
     ///
-    /// NaN from `0 * inf` (a direction component of zero with the origin on a slab plane) is ignored by the
-    /// `min`/`max` forms used here, which treats the ray as inside that slab.
-    pub fn clip_ray(
-        &self,
-        origin: Vec3,
-        inv_dir: Vec3,
-        tmin: f32,
-        tmax: f32,
-    ) -> Option<(f32, f32)> {
-        let ta = (self.min - origin) * inv_dir;
-        let tb = (self.max - origin) * inv_dir;
+    /// An axis with an infinite inverse direction (a zero direction component) constrains nothing when the
+    /// origin lies within that slab, boundary included, and misses otherwise; this avoids the NaN of `0 * inf`.
+    pub fn clip_ray(&self, origin: Vec3, inv_dir: Vec3, tmin: f32, tmax: f32) -> Option<(f32, f32)> {
         let mut t0 = tmin;
         let mut t1 = tmax;
         for k in 0..3 {
-            let (lo, hi) = if ta[k] <= tb[k] {
-                (ta[k], tb[k])
-            } else {
-                (tb[k], ta[k])
-            };
-            t0 = t0.max(lo);
-            t1 = t1.min(hi);
+            if inv_dir[k].is_infinite() {
+                if origin[k] < self.min[k] || origin[k] > self.max[k] {
+                    return None;
+                }
+                continue;
+            }
+            let ta = (self.min[k] - origin[k]) * inv_dir[k];
+            let tb = (self.max[k] - origin[k]) * inv_dir[k];
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
         }
         (t0 <= t1).then_some((t0, t1))
     }
@@ -167,9 +147,6 @@ mod tests {
         let r = b.clip_ray(Vec3::new(-1.0, 0.0, 0.5), inv, 0.0, f32::INFINITY);
         assert_eq!(r, Some((1.0, 2.0)));
         // Outside the y slab: miss.
-        assert_eq!(
-            b.clip_ray(Vec3::new(-1.0, 2.0, 0.5), inv, 0.0, f32::INFINITY),
-            None
-        );
+        assert_eq!(b.clip_ray(Vec3::new(-1.0, 2.0, 0.5), inv, 0.0, f32::INFINITY), None);
     }
 }

@@ -20,22 +20,12 @@ pub struct Ray {
 impl Ray {
     /// A ray from `origin` along `dir` over `[0, +inf]`.
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        Self {
-            origin,
-            dir,
-            tmin: 0.0,
-            tmax: f32::INFINITY,
-        }
+        Self { origin, dir, tmin: 0.0, tmax: f32::INFINITY }
     }
 
     /// A ray over `[tmin, tmax]`.
     pub fn segment(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Self {
-        Self {
-            origin,
-            dir,
-            tmin,
-            tmax,
-        }
+        Self { origin, dir, tmin, tmax }
     }
 
     /// The point at distance `t`.

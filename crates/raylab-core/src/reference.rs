@@ -17,9 +17,7 @@ pub struct BruteForce {
 impl BruteForce {
     /// Prepares the triangles of `scene`.
     pub fn new(scene: &Scene) -> Self {
-        Self {
-            tris: TriangleSoup::from_scene(scene),
-        }
+        Self { tris: TriangleSoup::from_scene(scene) }
     }
 
     /// The closest hit in `(tmin, tmax]`; among hits at the same distance the lowest triangle id wins.
@@ -35,12 +33,7 @@ impl BruteForce {
             if let Some(h) = shear.intersect(tri, ray.tmin, tmax)
                 && best.is_none_or(|b| h.t < b.t)
             {
-                best = Some(Hit {
-                    t: h.t,
-                    tri: i as u32,
-                    u: h.u,
-                    v: h.v,
-                });
+                best = Some(Hit { t: h.t, tri: i as u32, u: h.u, v: h.v });
             }
         }
         stats.isect_tests += self.tris.len() as u64;
@@ -55,18 +48,13 @@ impl BruteForce {
         }
         let shear = RayShear::new(ray);
         stats.isect_tests += self.tris.len() as u64;
-        self.tris
-            .as_slice()
-            .iter()
-            .any(|t| shear.intersect(t, ray.tmin, ray.tmax).is_some())
+        self.tris.as_slice().iter().any(|t| shear.intersect(t, ray.tmin, ray.tmax).is_some())
     }
 
     /// The distance at which `ray` hits triangle `tri`, if it does (used to check that two methods that
     /// report different triangles at the same distance both report a real hit).
     pub fn hit_distance(&self, ray: &Ray, tri: u32) -> Option<f32> {
         let t = self.tris.as_slice().get(tri as usize)?;
-        RayShear::new(ray)
-            .intersect(t, ray.tmin, ray.tmax)
-            .map(|h| h.t)
+        RayShear::new(ray).intersect(t, ray.tmin, ray.tmax).map(|h| h.t)
     }
 }

@@ -60,18 +60,8 @@ mod tests {
 
     #[test]
     fn merge_and_ratios() {
-        let mut a = TraversalStats {
-            rays: 2,
-            nodes: 10,
-            leaves: 4,
-            isect_tests: 6,
-        };
-        a += TraversalStats {
-            rays: 2,
-            nodes: 2,
-            leaves: 0,
-            isect_tests: 2,
-        };
+        let mut a = TraversalStats { rays: 2, nodes: 10, leaves: 4, isect_tests: 6 };
+        a += TraversalStats { rays: 2, nodes: 2, leaves: 0, isect_tests: 2 };
         assert_eq!(a.nodes_per_ray(), 3.0);
         assert_eq!(a.isects_per_ray(), 2.0);
         assert_eq!(TraversalStats::default().nodes_per_ray(), 0.0);

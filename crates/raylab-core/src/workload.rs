@@ -107,15 +107,10 @@ impl PrimaryPass {
     /// Traces every primary ray of a `width x height` image with `tracer`.
     pub fn trace(camera: &Camera, width: u32, height: u32, tracer: &dyn Intersector) -> Self {
         let raster = camera.raster(width, height);
-        let rays: Vec<Ray> = (0..height)
-            .flat_map(|y| (0..width).map(move |x| (x, y)))
-            .map(|(x, y)| raster.primary(x, y))
-            .collect();
+        let rays: Vec<Ray> =
+            (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| raster.primary(x, y)).collect();
         let mut stats = TraversalStats::default();
-        let hits = rays
-            .iter()
-            .map(|r| tracer.intersect(r, &mut stats))
-            .collect();
+        let hits = rays.iter().map(|r| tracer.intersect(r, &mut stats)).collect();
         Self { rays, hits }
     }
 
@@ -154,14 +149,7 @@ impl<'a> WorkloadBuilder<'a> {
         tracer: &dyn Intersector,
     ) -> Self {
         let pass = PrimaryPass::trace(camera, width, height, tracer);
-        Self {
-            scene,
-            width,
-            height,
-            light,
-            seed: Self::DEFAULT_SEED,
-            pass,
-        }
+        Self { scene, width, height, light, seed: Self::DEFAULT_SEED, pass }
     }
 
     /// Sets the diffuse seed.
@@ -178,11 +166,7 @@ impl<'a> WorkloadBuilder<'a> {
     /// The offset that lifts secondary origins off the surface: `1e-4` times the bounds' diagonal.
     pub fn epsilon(&self) -> f32 {
         let b = self.scene.bounds();
-        if b.is_empty() {
-            0.0
-        } else {
-            (1e-4 * (b.max.as_dvec3() - b.min.as_dvec3()).length()) as f32
-        }
+        if b.is_empty() { 0.0 } else { (1e-4 * (b.max.as_dvec3() - b.min.as_dvec3()).length()) as f32 }
     }
 
     /// The rays of `kind`.
@@ -191,37 +175,23 @@ impl<'a> WorkloadBuilder<'a> {
             RayKind::Primary => self.pass.rays.iter().map(|r| Some(*r)).collect(),
             RayKind::Shadow | RayKind::Diffuse => {
                 let eps = self.epsilon();
-                (0..self.pass.rays.len())
-                    .map(|i| self.secondary(kind, i, eps))
-                    .collect()
+                (0..self.pass.rays.len()).map(|i| self.secondary(kind, i, eps)).collect()
             }
         };
-        Workload {
-            kind,
-            width: self.width,
-            height: self.height,
-            rays,
-        }
+        Workload { kind, width: self.width, height: self.height, rays }
     }
 
     fn secondary(&self, kind: RayKind, i: usize, eps: f32) -> Option<Ray> {
         let hit = self.pass.hits[i]?;
         let pr = &self.pass.rays[i];
-        let ng = self
-            .scene
-            .geometric_normal_unnormalized(hit.tri as usize)
-            .as_dvec3();
+        let ng = self.scene.geometric_normal_unnormalized(hit.tri as usize).as_dvec3();
         let mut n: DVec3 = ng * (1.0 / ng.dot(ng).sqrt());
         if n.dot(pr.dir.as_dvec3()) > 0.0 {
             n = -n;
         }
         let n = n.as_vec3();
         let t = hit.t;
-        let p = Vec3::new(
-            pr.origin.x + t * pr.dir.x,
-            pr.origin.y + t * pr.dir.y,
-            pr.origin.z + t * pr.dir.z,
-        );
+        let p = Vec3::new(pr.origin.x + t * pr.dir.x, pr.origin.y + t * pr.dir.y, pr.origin.z + t * pr.dir.z);
         let q = Vec3::new(p.x + eps * n.x, p.y + eps * n.y, p.z + eps * n.z);
         Some(match kind {
             RayKind::Shadow => {

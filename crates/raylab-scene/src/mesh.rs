@@ -28,11 +28,7 @@ impl MeshBuilder {
     pub fn new() -> Self {
         let mut scene = SceneBuilder::new();
         scene.add_material(Material::default());
-        Self {
-            scene,
-            material: 0,
-            transform: Affine3A::IDENTITY,
-        }
+        Self { scene, material: 0, transform: Affine3A::IDENTITY }
     }
 
     /// The scene under construction (for lights, views and materials).
@@ -77,17 +73,13 @@ impl MeshBuilder {
     fn vertex(&mut self, p: Vec3, n: Vec3) -> u32 {
         let s = &mut self.scene;
         s.positions.push(self.transform.transform_point3(p));
-        s.normals
-            .push(self.transform.transform_vector3(n).normalize_or_zero());
+        s.normals.push(self.transform.transform_vector3(n).normalize_or_zero());
         s.uvs.push(Vec2::ZERO);
         (s.positions.len() - 1) as u32
     }
 
     fn tri(&mut self, a: u32, b: u32, c: u32) {
-        self.scene.triangles.push(Triangle {
-            v: [a, b, c],
-            material: self.material,
-        });
+        self.scene.triangles.push(Triangle { v: [a, b, c], material: self.material });
     }
 
     /// A flat triangle with its face normal.
@@ -108,11 +100,7 @@ impl MeshBuilder {
     /// A closed axis-aligned box.
     pub fn cuboid(&mut self, min: Vec3, max: Vec3) {
         let c = |x: bool, y: bool, z: bool| {
-            Vec3::new(
-                if x { max.x } else { min.x },
-                if y { max.y } else { min.y },
-                if z { max.z } else { min.z },
-            )
+            Vec3::new(if x { max.x } else { min.x }, if y { max.y } else { min.y }, if z { max.z } else { min.z })
         };
         let (f, t) = (false, true);
         self.quad(c(f, f, t), c(t, f, t), c(t, t, t), c(f, t, t)); // +z
@@ -136,12 +124,7 @@ impl MeshBuilder {
             let ((r0, y0), (r1, y1)) = (w[0], w[1]);
             let slope = Vec2::new(y1 - y0, -(r1 - r0)).normalize_or_zero();
             for k in 0..seg {
-                let p = [
-                    ring(r0, y0, k),
-                    ring(r0, y0, k + 1),
-                    ring(r1, y1, k + 1),
-                    ring(r1, y1, k),
-                ];
+                let p = [ring(r0, y0, k), ring(r0, y0, k + 1), ring(r1, y1, k + 1), ring(r1, y1, k)];
                 let normal = |k: u32| {
                     let a = TAU * (k % seg) as f32 / seg as f32;
                     Vec3::new(slope.x * a.cos(), slope.y, -slope.x * a.sin())
@@ -165,15 +148,8 @@ impl MeshBuilder {
             let n = Vec3::Y * dir;
             let centre = self.vertex(base + Vec3::Y * y, n);
             for k in 0..seg {
-                let (a, b) = (
-                    self.vertex(ring(r, y, k), n),
-                    self.vertex(ring(r, y, k + 1), n),
-                );
-                if dir > 0.0 {
-                    self.tri(centre, a, b)
-                } else {
-                    self.tri(centre, b, a)
-                }
+                let (a, b) = (self.vertex(ring(r, y, k), n), self.vertex(ring(r, y, k + 1), n));
+                if dir > 0.0 { self.tri(centre, a, b) } else { self.tri(centre, b, a) }
             }
         }
     }
@@ -189,11 +165,7 @@ impl MeshBuilder {
         let profile: Vec<(f32, f32)> = (0..=rings)
             .map(|i| {
                 let a = std::f32::consts::PI * i as f32 / rings as f32;
-                if i == 0 || i == rings {
-                    (0.0, -radius * a.cos())
-                } else {
-                    (radius * a.sin(), -radius * a.cos())
-                }
+                if i == 0 || i == rings { (0.0, -radius * a.cos()) } else { (radius * a.sin(), -radius * a.cos()) }
             })
             .collect();
         self.lathe(centre, &profile, segments);
@@ -211,12 +183,7 @@ impl MeshBuilder {
         };
         for i in 0..seg {
             for j in 0..sides {
-                let q = [
-                    point(i, j),
-                    point(i + 1, j),
-                    point(i + 1, j + 1),
-                    point(i, j + 1),
-                ];
+                let q = [point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)];
                 let v: Vec<u32> = q.iter().map(|&(p, n)| self.vertex(p, n)).collect();
                 self.tri(v[0], v[1], v[2]);
                 self.tri(v[0], v[2], v[3]);
@@ -235,43 +202,13 @@ impl MeshBuilder {
         };
         for k in 0..seg {
             let (k1, k2) = (k, k + 1);
-            self.quad(
-                at(inner, k1, h),
-                at(outer, k1, h),
-                at(outer, k2, h),
-                at(inner, k2, h),
-            );
-            self.quad(
-                at(outer, k1, -h),
-                at(inner, k1, -h),
-                at(inner, k2, -h),
-                at(outer, k2, -h),
-            );
-            self.quad(
-                at(outer, k1, h),
-                at(outer, k1, -h),
-                at(outer, k2, -h),
-                at(outer, k2, h),
-            );
-            self.quad(
-                at(inner, k1, -h),
-                at(inner, k1, h),
-                at(inner, k2, h),
-                at(inner, k2, -h),
-            );
+            self.quad(at(inner, k1, h), at(outer, k1, h), at(outer, k2, h), at(inner, k2, h));
+            self.quad(at(outer, k1, -h), at(inner, k1, -h), at(inner, k2, -h), at(outer, k2, -h));
+            self.quad(at(outer, k1, h), at(outer, k1, -h), at(outer, k2, -h), at(outer, k2, h));
+            self.quad(at(inner, k1, -h), at(inner, k1, h), at(inner, k2, h), at(inner, k2, -h));
         }
-        self.quad(
-            at(inner, 0, -h),
-            at(outer, 0, -h),
-            at(outer, 0, h),
-            at(inner, 0, h),
-        );
-        self.quad(
-            at(outer, seg, -h),
-            at(inner, seg, -h),
-            at(inner, seg, h),
-            at(outer, seg, h),
-        );
+        self.quad(at(inner, 0, -h), at(outer, 0, -h), at(outer, 0, h), at(inner, 0, h));
+        self.quad(at(outer, seg, -h), at(inner, seg, -h), at(inner, seg, h), at(outer, seg, h));
     }
 
     /// An open grid of `nu x nv` quads over `f(u, v)` for `u, v` in `[0, 1]` (cloth, terrain tops, leaves).
@@ -309,13 +246,13 @@ impl Jitter {
     }
 
     /// The next value in `[0, 1)`.
-    pub fn next(&mut self) -> f32 {
+    pub fn unit(&mut self) -> f32 {
         self.state = self.state.wrapping_add(1);
         (raylab_core::workload::pcg_hash(self.state) >> 8) as f32 / 16_777_216.0
     }
 
     /// The next value in `[lo, hi)`.
     pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
+        lo + (hi - lo) * self.unit()
     }
 }

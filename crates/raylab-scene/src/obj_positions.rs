@@ -24,20 +24,13 @@ pub struct ObjReport {
 
 /// Reads `path`.
 pub fn load(path: &Path) -> Result<(Scene, ObjReport), SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
     parse(&text, path)
 }
 
 /// Parses OBJ text; `path` is used in messages only.
 pub fn parse(text: &str, path: &Path) -> Result<(Scene, ObjReport), SceneError> {
-    let err = |line: usize, message: String| SceneError::Parse {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
+    let err = |line: usize, message: String| SceneError::Parse { path: path.to_path_buf(), line, message };
     let mut b = SceneBuilder::new();
     b.add_material(Material::diffuse("default", Vec3::ONE));
     let mut report = ObjReport::default();
@@ -49,12 +42,8 @@ pub fn parse(text: &str, path: &Path) -> Result<(Scene, ObjReport), SceneError> 
             Some("v") => {
                 let mut c = [0f32; 3];
                 for v in &mut c {
-                    let tok = it
-                        .next()
-                        .ok_or_else(|| err(line_no, "vertex needs 3 coordinates".into()))?;
-                    *v = tok
-                        .parse()
-                        .map_err(|_| err(line_no, format!("bad coordinate '{tok}'")))?;
+                    let tok = it.next().ok_or_else(|| err(line_no, "vertex needs 3 coordinates".into()))?;
+                    *v = tok.parse().map_err(|_| err(line_no, format!("bad coordinate '{tok}'")))?;
                 }
                 b.positions.push(Vec3::from_array(c));
             }
@@ -64,9 +53,7 @@ pub fn parse(text: &str, path: &Path) -> Result<(Scene, ObjReport), SceneError> 
                 let mut bad = false;
                 for tok in it {
                     let idx = tok.split('/').next().unwrap_or("");
-                    let i: i64 = idx
-                        .parse()
-                        .map_err(|_| err(line_no, format!("bad face index '{tok}'")))?;
+                    let i: i64 = idx.parse().map_err(|_| err(line_no, format!("bad face index '{tok}'")))?;
                     let count = b.positions.len() as i64;
                     let resolved = if i < 0 { count + i } else { i - 1 };
                     if i == 0 || resolved < 0 || resolved >= count {
@@ -80,10 +67,7 @@ pub fn parse(text: &str, path: &Path) -> Result<(Scene, ObjReport), SceneError> 
                     continue;
                 }
                 for k in 1..corners.len() - 1 {
-                    b.triangles.push(Triangle {
-                        v: [corners[0], corners[k], corners[k + 1]],
-                        material: 0,
-                    });
+                    b.triangles.push(Triangle { v: [corners[0], corners[k], corners[k + 1]], material: 0 });
                 }
             }
             _ => {}
@@ -92,11 +76,7 @@ pub fn parse(text: &str, path: &Path) -> Result<(Scene, ObjReport), SceneError> 
     if b.triangles.is_empty() {
         return Err(SceneError::Empty {
             path: path.to_path_buf(),
-            detail: format!(
-                "{} vertices, {} face records",
-                b.positions.len(),
-                report.faces
-            ),
+            detail: format!("{} vertices, {} face records", b.positions.len(), report.faces),
         });
     }
     Ok((b.build(), report))
@@ -108,37 +88,21 @@ mod tests {
 
     #[test]
     fn fans_negative_indices_and_skips() {
-        let text =
-            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2//3 3/4/5 4\nf -4 -3 -2\nf 1 2\nf 1 2 9\n";
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2//3 3/4/5 4\nf -4 -3 -2\nf 1 2\nf 1 2 9\n";
         let (s, r) = parse(text, Path::new("t.obj")).unwrap();
         assert_eq!(s.triangle_count(), 3);
         assert_eq!(s.triangles[1].v, [0, 2, 3]);
         assert_eq!(s.triangles[2].v, [0, 1, 2]);
-        assert_eq!(
-            r,
-            ObjReport {
-                faces: 4,
-                skipped_faces: 2
-            }
-        );
+        assert_eq!(r, ObjReport { faces: 4, skipped_faces: 2 });
     }
 
     #[test]
     fn errors_name_file_and_line() {
-        let e = parse("v 0 0 0\nv 1 x 0\n", Path::new("bad.obj"))
-            .unwrap_err()
-            .to_string();
+        let e = parse("v 0 0 0\nv 1 x 0\n", Path::new("bad.obj")).unwrap_err().to_string();
         assert!(e.starts_with("bad.obj:2:"), "{e}");
-        let e = parse("v 0 0 0\n", Path::new("none.obj"))
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("none.obj") && e.contains("no usable triangles"),
-            "{e}"
-        );
-        let e = parse("v 0 0\n", Path::new("short.obj"))
-            .unwrap_err()
-            .to_string();
+        let e = parse("v 0 0 0\n", Path::new("none.obj")).unwrap_err().to_string();
+        assert!(e.contains("none.obj") && e.contains("no usable triangles"), "{e}");
+        let e = parse("v 0 0\n", Path::new("short.obj")).unwrap_err().to_string();
         assert!(e.contains("short.obj:1"), "{e}");
     }
 }

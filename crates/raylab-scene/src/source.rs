@@ -20,30 +20,18 @@ impl SceneSource {
     /// Interprets a command-line value: a path when it ends in a known extension or contains a path
     /// separator, else a built-in name.
     pub fn parse(s: &str) -> Self {
-        let looks_like_path =
-            s.contains('/') || s.contains('\\') || Path::new(s).extension().is_some();
-        if looks_like_path {
-            Self::File(PathBuf::from(s))
-        } else {
-            Self::Builtin(s.to_string())
-        }
+        let looks_like_path = s.contains('/') || s.contains('\\') || Path::new(s).extension().is_some();
+        if looks_like_path { Self::File(PathBuf::from(s)) } else { Self::Builtin(s.to_string()) }
     }
 }
 
 /// Loads a scene. A file without lights or views gets none here; callers supply defaults.
 pub fn load(source: &SceneSource) -> Result<Scene, SceneError> {
     match source {
-        SceneSource::Builtin(name) => {
-            builtin::build(name, Detail::Full).ok_or_else(|| SceneError::UnknownScene {
-                name: name.clone(),
-                valid: builtin::names().join(", "),
-            })
-        }
+        SceneSource::Builtin(name) => builtin::build(name, Detail::Full)
+            .ok_or_else(|| SceneError::UnknownScene { name: name.clone(), valid: builtin::names().join(", ") }),
         SceneSource::File(path) => {
-            let ext = path
-                .extension()
-                .and_then(|e| e.to_str())
-                .map(str::to_ascii_lowercase);
+            let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
             match ext.as_deref() {
                 Some("obj") => crate::obj_positions::load(path).map(|(scene, _)| scene),
                 _ => Err(SceneError::Format { path: path.clone() }),

@@ -18,24 +18,14 @@ fn builtins_have_the_advertised_size_views_and_lights() {
         let scene = builtin::build(name, Detail::Full).unwrap();
         let secs = t0.elapsed().as_secs_f64();
         let n = scene.triangle_count();
-        assert!(
-            (lo..=hi).contains(&n),
-            "{name}: {n} triangles, expected {lo}..{hi}"
-        );
+        assert!((lo..=hi).contains(&n), "{name}: {n} triangles, expected {lo}..{hi}");
         assert!(secs < 2.0, "{name}: generated in {secs:.2} s");
         assert_eq!(scene.dropped.total(), 0, "{name}: {:?}", scene.dropped);
-        assert!(
-            !scene.views.is_empty() && !scene.lights.is_empty(),
-            "{name}"
-        );
+        assert!(!scene.views.is_empty() && !scene.lights.is_empty(), "{name}");
         for v in &scene.views {
             assert_eq!(v.camera.validate(), Ok(()), "{name}/{}", v.name);
         }
-        assert_eq!(
-            scene.normals.len(),
-            scene.positions.len(),
-            "{name} has per-vertex normals"
-        );
+        assert_eq!(scene.normals.len(), scene.positions.len(), "{name} has per-vertex normals");
     }
 }
 
@@ -51,9 +41,7 @@ fn builtins_are_deterministic() {
 
 #[test]
 fn unknown_names_list_the_builtins() {
-    let e = raylab_scene::load(&raylab_scene::SceneSource::Builtin("sponzaa".into()))
-        .unwrap_err()
-        .to_string();
+    let e = raylab_scene::load(&raylab_scene::SceneSource::Builtin("sponzaa".into())).unwrap_err().to_string();
     for name in builtin::names() {
         assert!(e.contains(name), "{e}");
     }

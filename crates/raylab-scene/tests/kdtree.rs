@@ -20,8 +20,7 @@ fn overlaps(t: &[Vec3; 3], lo: DVec3, hi: DVec3) -> bool {
         }
         let p = v.map(|q| q.dot(axis));
         let r = h.x * axis.x.abs() + h.y * axis.y.abs() + h.z * axis.z.abs();
-        p.iter().cloned().fold(f64::INFINITY, f64::min) > r
-            || p.iter().cloned().fold(f64::NEG_INFINITY, f64::max) < -r
+        p.iter().cloned().fold(f64::INFINITY, f64::min) > r || p.iter().cloned().fold(f64::NEG_INFINITY, f64::max) < -r
     };
     let units = [glam::DVec3::X, glam::DVec3::Y, glam::DVec3::Z];
     for u in units {
@@ -38,13 +37,8 @@ fn overlaps(t: &[Vec3; 3], lo: DVec3, hi: DVec3) -> bool {
 }
 
 fn check_leaf_coverage(scene: &Scene, tree: &KdTree, name: &str) {
-    let tris: Vec<[Vec3; 3]> = (0..scene.triangle_count())
-        .map(|i| scene.vertices(i))
-        .collect();
-    let tri_boxes: Vec<Aabb> = tris
-        .iter()
-        .map(|t| Aabb::from_points(t.iter().copied()))
-        .collect();
+    let tris: Vec<[Vec3; 3]> = (0..scene.triangle_count()).map(|i| scene.vertices(i)).collect();
+    let tri_boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(t.iter().copied())).collect();
     let mut leaves = 0;
     tree.visit(|_, bounds, node| {
         if !node.is_leaf() {
@@ -54,20 +48,13 @@ fn check_leaf_coverage(scene: &Scene, tree: &KdTree, name: &str) {
         // Shrink the leaf a little (in double precision, where the shrink survives): triangles that only
         // touch its boundary may sit in the neighbour.
         let shrink = bounds.extent().as_dvec3() * 1e-4;
-        let (lo, hi) = (
-            bounds.min.as_dvec3() + shrink,
-            bounds.max.as_dvec3() - shrink,
-        );
-        let held: std::collections::HashSet<u32> =
-            tree.tri_ids()[node.leaf_range()].iter().copied().collect();
+        let (lo, hi) = (bounds.min.as_dvec3() + shrink, bounds.max.as_dvec3() - shrink);
+        let held: std::collections::HashSet<u32> = tree.tri_ids()[node.leaf_range()].iter().copied().collect();
         for (i, t) in tris.iter().enumerate() {
             if tri_boxes[i].intersection(*bounds).is_empty() || held.contains(&(i as u32)) {
                 continue;
             }
-            assert!(
-                !overlaps(t, lo, hi),
-                "{name}: triangle {i} overlaps leaf {bounds:?} but is not in it"
-            );
+            assert!(!overlaps(t, lo, hi), "{name}: triangle {i} overlaps leaf {bounds:?} but is not in it");
         }
     });
     assert!(leaves > 1, "{name}: the tree was split");
@@ -87,59 +74,27 @@ fn sah_tree_costs_less_than_a_middle_split_tree() {
     for name in builtin::names() {
         let scene = builtin::build(name, Detail::Test).unwrap();
         let sah = KdTree::build(&scene, &KdParams::default()).unwrap().stats();
-        let mid = KdTree::build(
-            &scene,
-            &KdParams {
-                strategy: SplitStrategy::Middle,
-                ..KdParams::default()
-            },
-        )
-        .unwrap()
-        .stats();
-        assert!(
-            sah.sah_cost < mid.sah_cost,
-            "{name}: SAH {} vs middle {}",
-            sah.sah_cost,
-            mid.sah_cost
-        );
+        let mid = KdTree::build(&scene, &KdParams { strategy: SplitStrategy::Middle, ..KdParams::default() })
+            .unwrap()
+            .stats();
+        assert!(sah.sah_cost < mid.sah_cost, "{name}: SAH {} vs middle {}", sah.sah_cost, mid.sah_cost);
     }
 }
 
 #[test]
 fn stats_are_consistent_and_build_is_deterministic() {
     let scene = builtin::build("kitchen", Detail::Test).unwrap();
-    let params = KdParams {
-        parallel_min_tris: 256,
-        ..KdParams::default()
-    };
+    let params = KdParams { parallel_min_tris: 256, ..KdParams::default() };
     let a = KdTree::build(&scene, &params).unwrap();
-    let b = KdTree::build(
-        &scene,
-        &KdParams {
-            parallel_min_tris: usize::MAX,
-            ..params
-        },
-    )
-    .unwrap();
-    assert_eq!(
-        a.nodes(),
-        b.nodes(),
-        "parallel and sequential builds give the same tree"
-    );
+    let b = KdTree::build(&scene, &KdParams { parallel_min_tris: usize::MAX, ..params }).unwrap();
+    assert_eq!(a.nodes(), b.nodes(), "parallel and sequential builds give the same tree");
     assert_eq!(a.tri_ids(), b.tri_ids());
     let s = a.stats();
     assert_eq!(s.nodes, s.inner + s.leaves);
-    assert_eq!(
-        s.leaves,
-        s.inner + 1,
-        "a binary tree has one more leaf than inner nodes"
-    );
+    assert_eq!(s.leaves, s.inner + 1, "a binary tree has one more leaf than inner nodes");
     assert_eq!(s.tri_refs, a.tri_ids().len());
     assert!(s.max_depth <= params.depth_for(scene.triangle_count()));
-    assert!(
-        s.tri_refs >= scene.triangle_count(),
-        "every triangle is in at least one leaf"
-    );
+    assert!(s.tri_refs >= scene.triangle_count(), "every triangle is in at least one leaf");
     assert_eq!(std::mem::size_of::<raylab_core::kdtree::KdNode>(), 8);
     // Children are adjacent and even-aligned.
     for n in a.nodes() {
@@ -154,18 +109,9 @@ fn stats_are_consistent_and_build_is_deterministic() {
 fn bad_parameters_are_refused() {
     let scene = builtin::build("arena", Detail::Test).unwrap();
     for p in [
-        KdParams {
-            c_isect: 0.0,
-            ..KdParams::default()
-        },
-        KdParams {
-            c_trav: f32::NAN,
-            ..KdParams::default()
-        },
-        KdParams {
-            empty_bonus: 1.0,
-            ..KdParams::default()
-        },
+        KdParams { c_isect: 0.0, ..KdParams::default() },
+        KdParams { c_trav: f32::NAN, ..KdParams::default() },
+        KdParams { empty_bonus: 1.0, ..KdParams::default() },
     ] {
         let e = KdTree::build(&scene, &p).unwrap_err().to_string();
         assert!(e.contains("invalid kd-tree parameters"), "{e}");

@@ -13,17 +13,14 @@ use raylab_core::stats::TraversalStats;
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 
 fn sponza_path() -> Option<PathBuf> {
-    let p =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/sponza/sponza.obj");
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/sponza/sponza.obj");
     p.exists().then_some(p)
 }
 
 #[test]
 fn sponza_view_matches_the_embree_harness() {
     let Some(path) = sponza_path() else {
-        eprintln!(
-            "shared/scenes/sponza/sponza.obj not found beside the checkout; Sponza checks not run"
-        );
+        eprintln!("shared/scenes/sponza/sponza.obj not found beside the checkout; Sponza checks not run");
         return;
     };
     let (scene, report) = raylab_scene::obj_positions::load(&path).expect("sponza loads");
@@ -31,31 +28,18 @@ fn sponza_view_matches_the_embree_harness() {
     assert_eq!(scene.triangle_count() + scene.dropped.total(), 66_454);
     let tree = KdTree::build(&scene, &KdParams::default()).expect("build");
     // SOURCE.txt: --eye -12.5,2.5,0 --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0
-    let camera = Camera::look_at(
-        Vec3::new(-12.5, 2.5, 0.0),
-        Vec3::new(10.0, 5.5, 0.0),
-        Vec3::Y,
-        65.0,
-    );
+    let camera = Camera::look_at(Vec3::new(-12.5, 2.5, 0.0), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 65.0);
     let light = Vec3::new(0.0, 11.0, 0.0);
     let wb = WorkloadBuilder::new(&scene, &camera, light, 512, 512, &tree);
     let pass = wb.primary_pass();
     assert_eq!(pass.hits.len(), 262_144);
     assert_eq!(pass.hit_count(), 253_051);
     let sum_t = pass.sum_t();
-    assert!(
-        (sum_t - 2_948_403.820476).abs() / 2_948_403.820476 < 5e-7,
-        "sum_t {sum_t}"
-    );
+    assert!((sum_t - 2_948_403.820476).abs() / 2_948_403.820476 < 5e-7, "sum_t {sum_t}");
 
     let shadow = wb.build(RayKind::Shadow);
     let mut stats = TraversalStats::default();
-    let occluded = shadow
-        .rays
-        .iter()
-        .flatten()
-        .filter(|r| Intersector::occluded(&tree, r, &mut stats))
-        .count();
+    let occluded = shadow.rays.iter().flatten().filter(|r| Intersector::occluded(&tree, r, &mut stats)).count();
     assert_eq!(shadow.ray_count(), 253_051);
     assert_eq!(occluded, 123_414);
 
@@ -69,16 +53,9 @@ fn sponza_view_matches_the_embree_harness() {
         .filter_map(|r| Intersector::intersect(&tree, r, &mut stats))
         .map(|h| h.t)
         .collect();
-    assert!(
-        (hits.len() as i64 - 242_978).abs() <= 25,
-        "diffuse hits {}",
-        hits.len()
-    );
+    assert!((hits.len() as i64 - 242_978).abs() <= 25, "diffuse hits {}", hits.len());
     let dsum: f64 = hits.iter().map(|&t| t as f64).sum();
-    assert!(
-        (dsum - 1_670_015.08).abs() / 1_670_015.08 < 5e-4,
-        "diffuse sum_t {dsum}"
-    );
+    assert!((dsum - 1_670_015.08).abs() / 1_670_015.08 < 5e-4, "diffuse sum_t {dsum}");
 }
 
 /// raylab's benchmark shading of the Sponza view against the harness's own render of it
@@ -86,28 +63,15 @@ fn sponza_view_matches_the_embree_harness() {
 #[test]
 fn sponza_render_matches_embree_pixel_for_pixel() {
     let Some(path) = sponza_path() else {
-        eprintln!(
-            "shared/scenes/sponza/sponza.obj not found beside the checkout; Sponza render check not run"
-        );
+        eprintln!("shared/scenes/sponza/sponza.obj not found beside the checkout; Sponza render check not run");
         return;
     };
-    let reference = image::open(path.with_file_name("embree_view.png"))
-        .expect("embree_view.png")
-        .to_luma8();
+    let reference = image::open(path.with_file_name("embree_view.png")).expect("embree_view.png").to_luma8();
     let (scene, _) = raylab_scene::obj_positions::load(&path).unwrap();
     let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let camera = Camera::look_at(
-        Vec3::new(-12.5, 2.5, 0.0),
-        Vec3::new(10.0, 5.5, 0.0),
-        Vec3::Y,
-        65.0,
-    );
+    let camera = Camera::look_at(Vec3::new(-12.5, 2.5, 0.0), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 65.0);
     let light = raylab_core::scene::PointLight::at(Vec3::new(0.0, 11.0, 0.0));
-    let settings = raylab_core::render::RenderSettings {
-        width: 1280,
-        height: 720,
-        ..Default::default()
-    };
+    let settings = raylab_core::render::RenderSettings { width: 1280, height: 720, ..Default::default() };
     let frame = raylab_core::render::render(&scene, &tree, &camera, light, &settings);
     assert_eq!((reference.width(), reference.height()), (1280, 720));
     let (mut off_by_one, mut different) = (0, 0);
@@ -122,12 +86,6 @@ fn sponza_render_matches_embree_pixel_for_pixel() {
     // differ where the two tracers' last bits of t differ.
     let n = frame.rgba.len();
     eprintln!("{off_by_one} pixels off by one level, {different} differ more, of {n}");
-    assert!(
-        different * 1000 < n,
-        "{different} of {n} pixels differ by more than one level"
-    );
-    assert!(
-        off_by_one * 20 < n,
-        "{off_by_one} of {n} pixels differ by one level"
-    );
+    assert!(different * 1000 < n, "{different} of {n} pixels differ by more than one level");
+    assert!(off_by_one * 20 < n, "{off_by_one} of {n} pixels differ by one level");
 }

@@ -26,10 +26,8 @@ fn mono_matches_brute_force_on_every_builtin_scene() {
         // Camera rays from the scene's own views, including the corners of the image.
         let cam = scene.default_view().expect("view").camera;
         let raster = cam.raster(37, 23);
-        let primary: Vec<Ray> = (0..23)
-            .flat_map(|y| (0..37).map(move |x| (x, y)))
-            .map(|(x, y)| raster.primary(x, y))
-            .collect();
+        let primary: Vec<Ray> =
+            (0..23).flat_map(|y| (0..37).map(move |x| (x, y))).map(|(x, y)| raster.primary(x, y)).collect();
         check_hits(&scene, &t, &primary, name);
     }
 }
@@ -38,31 +36,13 @@ fn mono_matches_brute_force_on_every_builtin_scene() {
 fn mono_matches_brute_force_with_other_tree_parameters() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();
     for params in [
-        KdParams {
-            max_depth: Some(3),
-            ..KdParams::default()
-        },
-        KdParams {
-            empty_bonus: 0.0,
-            c_isect: 1.5,
-            ..KdParams::default()
-        },
-        KdParams {
-            parallel_min_tris: 64,
-            ..KdParams::default()
-        },
-        KdParams {
-            strategy: raylab_core::kdtree::SplitStrategy::Middle,
-            ..KdParams::default()
-        },
+        KdParams { max_depth: Some(3), ..KdParams::default() },
+        KdParams { empty_bonus: 0.0, c_isect: 1.5, ..KdParams::default() },
+        KdParams { parallel_min_tris: 64, ..KdParams::default() },
+        KdParams { strategy: raylab_core::kdtree::SplitStrategy::Middle, ..KdParams::default() },
     ] {
         let t = KdTree::build(&scene, &params).unwrap();
-        check_hits(
-            &scene,
-            &t,
-            &adversarial_rays(&scene, &t, 150, 5),
-            &format!("{params:?}"),
-        );
+        check_hits(&scene, &t, &adversarial_rays(&scene, &t, 150, 5), &format!("{params:?}"));
     }
 }
 
@@ -78,22 +58,12 @@ fn empty_scene_and_single_triangle() {
 
     let mut b = SceneBuilder::new();
     b.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
-    b.triangles = vec![Triangle {
-        v: [0, 1, 2],
-        material: 0,
-    }];
+    b.triangles = vec![Triangle { v: [0, 1, 2], material: 0 }];
     let one = b.build();
     let t = tree(&one);
-    let hit = t
-        .intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::NEG_Z), &mut s)
-        .expect("hit");
+    let hit = t.intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::NEG_Z), &mut s).expect("hit");
     assert_eq!((hit.tri, hit.t), (0, 1.0));
-    check_hits(
-        &one,
-        &t,
-        &adversarial_rays(&one, &t, 200, 3),
-        "one triangle",
-    );
+    check_hits(&one, &t, &adversarial_rays(&one, &t, 200, 3), "one triangle");
 }
 
 #[test]
@@ -101,22 +71,9 @@ fn camera_inside_geometry() {
     let scene = builtin::build("arena", Detail::Test).unwrap();
     let t = tree(&scene);
     // Origins inside pillars, tiles and walls of the arena, shooting in every axis direction and diagonally.
-    let inside = [
-        Vec3::new(8.0, 2.0, 0.0),
-        Vec3::new(-19.0, -0.1, -19.0),
-        Vec3::new(0.0, 4.0, 20.5),
-    ];
-    let dirs = [
-        Vec3::X,
-        Vec3::NEG_Y,
-        Vec3::Z,
-        Vec3::new(1.0, 1.0, 1.0),
-        Vec3::new(-0.3, 0.2, -1.0),
-    ];
-    let rays: Vec<Ray> = inside
-        .iter()
-        .flat_map(|&o| dirs.iter().map(move |&d| Ray::new(o, d)))
-        .collect();
+    let inside = [Vec3::new(8.0, 2.0, 0.0), Vec3::new(-19.0, -0.1, -19.0), Vec3::new(0.0, 4.0, 20.5)];
+    let dirs = [Vec3::X, Vec3::NEG_Y, Vec3::Z, Vec3::new(1.0, 1.0, 1.0), Vec3::new(-0.3, 0.2, -1.0)];
+    let rays: Vec<Ray> = inside.iter().flat_map(|&o| dirs.iter().map(move |&d| Ray::new(o, d))).collect();
     check_hits(&scene, &t, &rays, "inside geometry");
 }
 
@@ -132,20 +89,11 @@ fn scaled(scale: f32, offset: Vec3) -> Scene {
 
 #[test]
 fn huge_and_tiny_coordinates() {
-    for (scale, offset) in [
-        (1e4, Vec3::ZERO),
-        (1e-4, Vec3::ZERO),
-        (1.0, Vec3::splat(1e5)),
-        (1e-3, Vec3::splat(-50.0)),
-    ] {
+    for (scale, offset) in [(1e4, Vec3::ZERO), (1e-4, Vec3::ZERO), (1.0, Vec3::splat(1e5)), (1e-3, Vec3::splat(-50.0))]
+    {
         let scene = scaled(scale, offset);
         let t = tree(&scene);
-        check_hits(
-            &scene,
-            &t,
-            &adversarial_rays(&scene, &t, 200, 9),
-            &format!("scale {scale} offset {offset}"),
-        );
+        check_hits(&scene, &t, &adversarial_rays(&scene, &t, 200, 9), &format!("scale {scale} offset {offset}"));
     }
 }
 
@@ -178,12 +126,6 @@ fn counters_add_up() {
         }
     }
     assert_eq!(s.rays, 256);
-    assert!(
-        hits > 128,
-        "the default view looks at geometry ({hits} hits)"
-    );
-    assert!(
-        s.leaves >= 256 && s.nodes > s.leaves && s.isect_tests > 0,
-        "{s:?}"
-    );
+    assert!(hits > 128, "the default view looks at geometry ({hits} hits)");
+    assert!(s.leaves >= 256 && s.nodes > s.leaves && s.isect_tests > 0, "{s:?}");
 }

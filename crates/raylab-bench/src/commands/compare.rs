@@ -63,99 +63,50 @@ struct EmbreeRun {
     checks: Vec<String>,
 }
 
-fn run_embree(
-    a: &CompareArgs,
-    cam: &raylab_core::scene::Camera,
-    light: glam::Vec3,
-) -> Result<EmbreeRun, String> {
+fn run_embree(a: &CompareArgs, cam: &raylab_core::scene::Camera, light: glam::Vec3) -> Result<EmbreeRun, String> {
     let v = |p: glam::Vec3| format!("{},{},{}", p.x, p.y, p.z);
     let threads: Vec<String> = a.threads.iter().map(u64::to_string).collect();
     let out = Command::new(&a.embree)
         .arg(&a.scene.scene)
-        .args([
-            "--eye",
-            &v(cam.eye),
-            "--target",
-            &v(cam.target),
-            "--up",
-            &v(cam.up),
-        ])
+        .args(["--eye", &v(cam.eye), "--target", &v(cam.target), "--up", &v(cam.up)])
         .args(["--fov", &cam.vfov_deg.to_string(), "--light", &v(light)])
-        .args([
-            "--width",
-            &a.width.to_string(),
-            "--height",
-            &a.height.to_string(),
-        ])
-        .args([
-            "--threads",
-            &threads.join(","),
-            "--reps",
-            &a.reps.to_string(),
-        ])
-        .args([
-            "--warmup",
-            &a.warmup.to_string(),
-            "--builds",
-            &a.builds.to_string(),
-        ])
+        .args(["--width", &a.width.to_string(), "--height", &a.height.to_string()])
+        .args(["--threads", &threads.join(","), "--reps", &a.reps.to_string()])
+        .args(["--warmup", &a.warmup.to_string(), "--builds", &a.builds.to_string()])
         .args(["--kinds", "primary_1,shadow_1,diffuse_1"])
         .output()
         .map_err(|e| format!("--embree: cannot run {}: {e}", a.embree.display()))?;
     let text = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
-        return Err(format!(
-            "{} failed: {}{}",
-            a.embree.display(),
-            text,
-            String::from_utf8_lossy(&out.stderr)
-        ));
+        return Err(format!("{} failed: {}{}", a.embree.display(), text, String::from_utf8_lossy(&out.stderr)));
     }
-    let mut run = EmbreeRun {
-        builds: vec![],
-        rows: vec![],
-        checks: vec![],
-    };
+    let mut run = EmbreeRun { builds: vec![], rows: vec![], checks: vec![] };
     for line in text.lines() {
         if let Some(rest) = line.strip_prefix("build HIGH") {
             // "       1 thread(s): median 0.108 s (min ...)"
             let t: Option<u64> = rest.split_whitespace().next().and_then(|s| s.parse().ok());
-            let m: Option<f64> = rest
-                .split("median")
-                .nth(1)
-                .and_then(|s| s.split_whitespace().next()?.parse().ok());
+            let m: Option<f64> = rest.split("median").nth(1).and_then(|s| s.split_whitespace().next()?.parse().ok());
             if let (Some(t), Some(m)) = (t, m) {
                 run.builds.push((t, m));
             }
         } else if let Some(rest) = line.strip_prefix("CSV,") {
             let f: Vec<&str> = rest.split(',').collect();
             if f.len() >= 7 && f[0] != "res" {
-                let num = |i: usize| {
-                    f[i].parse::<f64>()
-                        .map_err(|_| format!("bad CSV line from embree: {line}"))
-                };
+                let num = |i: usize| f[i].parse::<f64>().map_err(|_| format!("bad CSV line from embree: {line}"));
                 run.rows.push(EmbreeRow {
                     kind: f[1].to_string(),
-                    threads: f[2]
-                        .parse()
-                        .map_err(|_| format!("bad CSV line from embree: {line}"))?,
+                    threads: f[2].parse().map_err(|_| format!("bad CSV line from embree: {line}"))?,
                     median: num(4)?,
                     min: num(5)?,
                     max: num(6)?,
                 });
             }
-        } else if line.starts_with("## ")
-            || line.starts_with("shadow rays")
-            || line.starts_with("diffuse rays")
-        {
+        } else if line.starts_with("## ") || line.starts_with("shadow rays") || line.starts_with("diffuse rays") {
             run.checks.push(line.trim_start_matches("## ").to_string());
         }
     }
     if run.rows.is_empty() {
-        return Err(format!(
-            "no CSV rows in the output of {}",
-            a.embree.display()
-        ));
+        return Err(format!("no CSV rows in the output of {}", a.embree.display()));
     }
     Ok(run)
 }
@@ -165,9 +116,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let env = Environment::detect();
     let (scene, _) = load_scene(&a.scene.source())?;
     let (cam, light) = a.scene.camera_and_light(&scene)?;
-    let embree = with_spinner("running the Embree harness", || {
-        run_embree(a, &cam, light.position)
-    })?;
+    let embree = with_spinner("running the Embree harness", || run_embree(a, &cam, light.position))?;
 
     let params = a.kd.params()?;
     let mut builds = Vec::new();
@@ -185,22 +134,13 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let tree = tree.ok_or("--threads: no thread count given")?;
     let reference = BruteForce::new(&scene);
     let (w, h) = (a.width as u32, a.height as u32);
-    let wb = with_spinner("generating rays", || {
-        WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree)
-    });
+    let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree));
     let mut ours: Vec<TraceReport> = Vec::new();
     for kind in RayKind::ALL {
         let workload = wb.build(kind);
         for &t in &a.threads {
-            let (report, results) = measure(
-                &tree,
-                &workload,
-                t as usize,
-                a.warmup as usize,
-                a.reps as usize,
-            )?;
-            validate(&reference, &workload, &results, 256)
-                .map_err(|m| format!("validation failed: {m}"))?;
+            let (report, results) = measure(&tree, &workload, t as usize, a.warmup as usize, a.reps as usize)?;
+            validate(&reference, &workload, &results, 256).map_err(|m| format!("validation failed: {m}"))?;
             ours.push(report);
         }
     }
@@ -209,11 +149,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let cmd: Vec<String> = std::env::args().collect();
     let _ = writeln!(md, "Machine and build: {}.", env.line());
     let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
-    let _ = writeln!(
-        md,
-        "\nEmbree harness checks: {}.\n",
-        embree.checks.join("; ")
-    );
+    let _ = writeln!(md, "\nEmbree harness checks: {}.\n", embree.checks.join("; "));
     let _ = writeln!(
         md,
         "| rays | threads | raylab mono Mrays/s (min-max) | Embree API | Embree Mrays/s (min-max) | raylab / Embree | raylab hits, sum_t | nodes/ray | tests/ray |"
@@ -225,15 +161,11 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             RayKind::Shadow => ("rtcOccluded1", "shadow_1"),
             RayKind::Diffuse => ("rtcIntersect1", "diffuse_1"),
         };
-        let e = embree
-            .rows
-            .iter()
-            .find(|e| e.kind == ekind && e.threads == r.threads as u64);
+        let e = embree.rows.iter().find(|e| e.kind == ekind && e.threads == r.threads as u64);
         let (es, ratio) = match e {
-            Some(e) => (
-                format!("{:.2} ({:.2}-{:.2})", e.median, e.min, e.max),
-                format!("{:.2}x", r.mrays_median / e.median),
-            ),
+            Some(e) => {
+                (format!("{:.2} ({:.2}-{:.2})", e.median, e.min, e.max), format!("{:.2}x", r.mrays_median / e.median))
+            }
             None => ("n/a".into(), "n/a".into()),
         };
         let check = if r.kind.is_occlusion() {
@@ -257,23 +189,15 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             r.isects_per_ray
         );
     }
-    let _ = writeln!(
-        md,
-        "\n| build | threads | raylab kd-tree (SAH, perfect splits) s | Embree BVH (HIGH) s |"
-    );
+    let _ = writeln!(md, "\n| build | threads | raylab kd-tree (SAH, perfect splits) s | Embree BVH (HIGH) s |");
     let _ = writeln!(md, "|---|---:|---:|---:|");
     for (t, s) in &builds {
-        let e = embree
-            .builds
-            .iter()
-            .find(|(et, _)| et == t)
-            .map_or("n/a".into(), |(_, s)| format!("{s:.3}"));
+        let e = embree.builds.iter().find(|(et, _)| et == t).map_or("n/a".into(), |(_, s)| format!("{s:.3}"));
         let _ = writeln!(md, "| median of {} | {} | {:.3} | {} |", a.builds, t, s, e);
     }
     print!("{md}");
     if let Some(p) = &a.markdown {
-        std::fs::write(p, &md)
-            .map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
+        std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
     }
     Ok(())
 }

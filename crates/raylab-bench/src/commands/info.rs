@@ -47,35 +47,14 @@ pub fn run(a: &InfoArgs) -> Result<(), String> {
         return Ok(());
     }
     println!("scene            {}", a.scene.scene);
-    println!(
-        "triangles        {} ({} dropped: {:?})",
-        scene.triangle_count(),
-        scene.dropped.total(),
-        scene.dropped
-    );
+    println!("triangles        {} ({} dropped: {:?})", scene.triangle_count(), scene.dropped.total(), scene.dropped);
     println!("vertices         {}", scene.positions.len());
-    println!(
-        "bounds           {:?} - {:?}, diagonal {:.4}",
-        b.min.to_array(),
-        b.max.to_array(),
-        b.diagonal()
-    );
-    let names: Vec<_> = scene
-        .materials
-        .iter()
-        .map(|m| format!("{} ({:?})", m.name, m.kind))
-        .collect();
+    println!("bounds           {:?} - {:?}, diagonal {:.4}", b.min.to_array(), b.max.to_array(), b.diagonal());
+    let names: Vec<_> = scene.materials.iter().map(|m| format!("{} ({:?})", m.name, m.kind)).collect();
     println!("materials        {}: {}", names.len(), names.join(", "));
     println!("lights           {}", scene.lights.len());
     let views: Vec<_> = scene.views.iter().map(|v| v.name.as_str()).collect();
-    println!(
-        "views            {}",
-        if views.is_empty() {
-            "none".into()
-        } else {
-            views.join(", ")
-        }
-    );
+    println!("views            {}", if views.is_empty() { "none".into() } else { views.join(", ") });
     println!("load             {load_s:.3} s");
     println!(
         "kd params        c_trav {} c_isect {} empty_bonus {} max_depth {}",
@@ -84,24 +63,14 @@ pub fn run(a: &InfoArgs) -> Result<(), String> {
         params.empty_bonus,
         params.depth_for(scene.triangle_count())
     );
-    println!(
-        "kd build         {:.3} s on {} thread(s)",
-        st.build_seconds, a.threads
-    );
-    println!(
-        "kd nodes         {} ({} inner, {} leaves, {} empty)",
-        st.nodes, st.inner, st.leaves, st.empty_leaves
-    );
+    println!("kd build         {:.3} s on {} thread(s)", st.build_seconds, a.threads);
+    println!("kd nodes         {} ({} inner, {} leaves, {} empty)", st.nodes, st.inner, st.leaves, st.empty_leaves);
     println!(
         "kd leaves        {:.2} triangles per non-empty leaf (max {}), {} references",
         st.avg_tris_per_leaf, st.max_tris_per_leaf, st.tri_refs
     );
     println!("kd depth         {}", st.max_depth);
-    println!(
-        "kd bytes         {} ({:.2} MiB)",
-        st.bytes,
-        st.bytes as f64 / (1 << 20) as f64
-    );
+    println!("kd bytes         {} ({:.2} MiB)", st.bytes, st.bytes as f64 / (1 << 20) as f64);
     println!("kd SAH cost      {:.3}", st.sah_cost);
     Ok(())
 }

@@ -54,10 +54,7 @@ impl RenderArgs {
 
 /// Runs the command.
 pub fn run(a: &RenderArgs) -> Result<(), String> {
-    let threads = a.threads.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |t| t as usize,
-    );
+    let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
     let (scene, load_s) = load_scene(&a.scene.source())?;
     let (camera, light) = a.scene.camera_and_light(&scene)?;
     let tree = build_tree(&scene, &a.kd.params()?, threads)?;
@@ -68,18 +65,13 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         order: a.order,
         shadows: !a.no_shadows,
     };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| e.to_string())?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     let t0 = Instant::now();
     let frame = pool.install(|| render(&scene, &tree, &camera, light, &settings));
     let render_s = t0.elapsed().as_secs_f64();
     let rgba: Vec<u8> = frame.rgba.iter().flatten().copied().collect();
-    let img = image::RgbaImage::from_raw(frame.width, frame.height, rgba)
-        .ok_or("frame buffer size mismatch")?;
-    img.save(&a.out)
-        .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    let img = image::RgbaImage::from_raw(frame.width, frame.height, rgba).ok_or("frame buffer size mismatch")?;
+    img.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
     println!(
         "{}: {} triangles, loaded in {:.3} s, kd-tree in {:.3} s; rendered {}x{} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",
         a.scene.scene,

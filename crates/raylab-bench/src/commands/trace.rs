@@ -67,13 +67,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         Method::Mono => &tree as &KdTree,
         Method::Reference => &reference,
     };
-    let (report, results) = measure(
-        tracer,
-        &workload,
-        a.threads as usize,
-        a.warmup as usize,
-        a.reps as usize,
-    )?;
+    let (report, results) = measure(tracer, &workload, a.threads as usize, a.warmup as usize, a.reps as usize)?;
     let checked = with_spinner("validating against brute force", || {
         validate(&reference, &workload, &results, a.validate as usize)
     })
@@ -96,24 +90,10 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         return Ok(());
     }
     println!("environment      {}", env.line());
-    println!(
-        "scene            {} ({} triangles), {}x{}",
-        a.scene.scene,
-        scene.triangle_count(),
-        w,
-        h
-    );
-    println!(
-        "kd-tree          built in {:.3} s on {} thread(s)",
-        tree.build_time().as_secs_f64(),
-        a.threads
-    );
+    println!("scene            {} ({} triangles), {}x{}", a.scene.scene, scene.triangle_count(), w, h);
+    println!("kd-tree          built in {:.3} s on {} thread(s)", tree.build_time().as_secs_f64(), a.threads);
     println!("validated        {checked} rays against brute force");
-    let what = if a.kind.is_occlusion() {
-        "occluded"
-    } else {
-        "hits"
-    };
+    let what = if a.kind.is_occlusion() { "occluded" } else { "hits" };
     println!(
         "{} {} threads {}: rays {}, {} {}, sum_t {:.6}",
         a.kind, a.method, report.threads, report.rays, what, report.hits, report.sum_t

@@ -49,10 +49,7 @@ struct Event {
 impl Event {
     fn new(pos: f32, tri: u32, kind: u32) -> Self {
         // `+ 0.0` turns -0.0 into +0.0 so that equal positions sort together.
-        Self {
-            pos: pos + 0.0,
-            packed: (tri << 2) | kind,
-        }
+        Self { pos: pos + 0.0, packed: (tri << 2) | kind }
     }
     fn tri(self) -> usize {
         (self.packed >> 2) as usize
@@ -91,11 +88,7 @@ struct Ctx<'a> {
 
 /// Builds the tree over `tris` inside `bounds` (which must hold every triangle).
 pub(super) fn build(tris: &[[Vec3; 3]], bounds: Aabb, params: &KdParams) -> BuildOutput {
-    let ctx = Ctx {
-        tris,
-        params,
-        max_depth: params.depth_for(tris.len()),
-    };
+    let ctx = Ctx { tris, params, max_depth: params.depth_for(tris.len()) };
     let mut events: Events = Default::default();
     for (a, list) in events.iter_mut().enumerate() {
         list.reserve(2 * tris.len());
@@ -105,19 +98,9 @@ pub(super) fn build(tris: &[[Vec3; 3]], bounds: Aabb, params: &KdParams) -> Buil
         }
     }
     rayon::scope(|_| {
-        events
-            .iter_mut()
-            .for_each(|l| l.sort_unstable_by_key(|e| e.key()));
+        events.iter_mut().for_each(|l| l.sort_unstable_by_key(|e| e.key()));
     });
-    build_parallel(
-        &ctx,
-        Task {
-            bounds,
-            events,
-            n: tris.len(),
-            depth: 0,
-        },
-    )
+    build_parallel(&ctx, Task { bounds, events, n: tris.len(), depth: 0 })
 }
 
 fn push_events(list: &mut Vec<Event>, axis: usize, tri: u32, b: &Aabb) {
@@ -149,34 +132,19 @@ fn build_parallel(ctx: &Ctx, task: Task) -> BuildOutput {
 /// Joins two subtrees under a new root: `[root, left root, right root, left rest.., right rest..]`.
 fn splice(axis: u8, split: f32, lo: BuildOutput, ro: BuildOutput) -> BuildOutput {
     let mut nodes = Vec::with_capacity(1 + lo.nodes.len() + ro.nodes.len());
-    nodes.push(BuildNode::Inner {
-        axis,
-        split,
-        left: 1,
-    });
+    nodes.push(BuildNode::Inner { axis, split, left: 1 });
     let lo_rest = 3;
     let ro_rest = lo_rest + lo.nodes.len() as u32 - 1;
     let map = |i: u32, root: u32, rest: u32| if i == 0 { root } else { rest + i - 1 };
     let relocate = |n: BuildNode, root: u32, rest: u32, tri_base: u32| match n {
-        BuildNode::Inner { axis, split, left } => BuildNode::Inner {
-            axis,
-            split,
-            left: map(left, root, rest),
-        },
-        BuildNode::Leaf { first, count } => BuildNode::Leaf {
-            first: first + tri_base,
-            count,
-        },
+        BuildNode::Inner { axis, split, left } => BuildNode::Inner { axis, split, left: map(left, root, rest) },
+        BuildNode::Leaf { first, count } => BuildNode::Leaf { first: first + tri_base, count },
     };
     let tri_base = lo.tri_ids.len() as u32;
     nodes.push(relocate(lo.nodes[0], 1, lo_rest, 0));
     nodes.push(relocate(ro.nodes[0], 2, ro_rest, tri_base));
     nodes.extend(lo.nodes[1..].iter().map(|&n| relocate(n, 1, lo_rest, 0)));
-    nodes.extend(
-        ro.nodes[1..]
-            .iter()
-            .map(|&n| relocate(n, 2, ro_rest, tri_base)),
-    );
+    nodes.extend(ro.nodes[1..].iter().map(|&n| relocate(n, 2, ro_rest, tri_base)));
     let mut tri_ids = lo.tri_ids;
     tri_ids.extend_from_slice(&ro.tri_ids);
     BuildOutput { nodes, tri_ids }
@@ -184,36 +152,21 @@ fn splice(axis: u8, split: f32, lo: BuildOutput, ro: BuildOutput) -> BuildOutput
 
 /// Builds a subtree depth-first with an explicit stack.
 fn build_sequential(ctx: &Ctx, root: Task) -> BuildOutput {
-    let mut out = BuildOutput {
-        nodes: vec![BuildNode::Leaf { first: 0, count: 0 }],
-        tri_ids: Vec::new(),
-    };
+    let mut out = BuildOutput { nodes: vec![BuildNode::Leaf { first: 0, count: 0 }], tri_ids: Vec::new() };
     let mut side = vec![0u8; ctx.tris.len()];
     let mut stack = vec![(0usize, root)];
     while let Some((idx, task)) = stack.pop() {
         match find_split(ctx, &task) {
             None => {
                 let first = out.tri_ids.len() as u32;
-                out.tri_ids.extend(
-                    task.events[0]
-                        .iter()
-                        .filter(|e| e.kind() != END)
-                        .map(|e| e.tri() as u32),
-                );
-                out.nodes[idx] = BuildNode::Leaf {
-                    first,
-                    count: task.n as u32,
-                };
+                out.tri_ids.extend(task.events[0].iter().filter(|e| e.kind() != END).map(|e| e.tri() as u32));
+                out.nodes[idx] = BuildNode::Leaf { first, count: task.n as u32 };
             }
             Some(split) => {
                 let left = out.nodes.len();
                 out.nodes.push(BuildNode::Leaf { first: 0, count: 0 });
                 out.nodes.push(BuildNode::Leaf { first: 0, count: 0 });
-                out.nodes[idx] = BuildNode::Inner {
-                    axis: split.axis as u8,
-                    split: split.pos,
-                    left: left as u32,
-                };
+                out.nodes[idx] = BuildNode::Inner { axis: split.axis as u8, split: split.pos, left: left as u32 };
                 let (l, r) = partition(ctx, task, &split, &mut side);
                 stack.push((left + 1, r));
                 stack.push((left, l));
@@ -223,27 +176,42 @@ fn build_sequential(ctx: &Ctx, root: Task) -> BuildOutput {
     out
 }
 
-/// The SAH cost of splitting `b` at `pos` on `axis` with `nl` and `nr` triangles on the two sides.
-fn split_cost(
-    p: &KdParams,
-    b: &Aabb,
-    inv_sa: f32,
-    axis: usize,
-    pos: f32,
-    nl: usize,
-    nr: usize,
-) -> f32 {
-    let e = b.extent();
-    let (e1, e2) = (e[(axis + 1) % 3], e[(axis + 2) % 3]);
-    let cap = e1 * e2;
-    let ring = e1 + e2;
-    let sa_l = 2.0 * (cap + (pos - b.min[axis]) * ring);
-    let sa_r = 2.0 * (cap + (b.max[axis] - pos) * ring);
-    let cost = p.c_trav + p.c_isect * (sa_l * nl as f32 + sa_r * nr as f32) * inv_sa;
-    if nl == 0 || nr == 0 {
-        cost * (1.0 - p.empty_bonus)
-    } else {
-        cost
+/// The node-constant parts of the SAH cost (thesis Eq. 2.1) for planes on one axis.
+struct AxisCost {
+    min: f32,
+    max: f32,
+    /// Area of the two faces parallel to the plane.
+    cap: f32,
+    /// Perimeter of those faces: a side's area grows by `ring` per unit of width.
+    ring: f32,
+    c_trav: f32,
+    /// `c_isect` divided by the node's area.
+    c_isect_per_sa: f32,
+    empty_factor: f32,
+}
+
+impl AxisCost {
+    fn new(p: &KdParams, b: &Aabb, axis: usize) -> Self {
+        let e = b.extent();
+        let (e1, e2) = (e[(axis + 1) % 3], e[(axis + 2) % 3]);
+        Self {
+            min: b.min[axis],
+            max: b.max[axis],
+            cap: 2.0 * e1 * e2,
+            ring: 2.0 * (e1 + e2),
+            c_trav: p.c_trav,
+            c_isect_per_sa: p.c_isect / b.surface_area(),
+            empty_factor: 1.0 - p.empty_bonus,
+        }
+    }
+
+    /// Cost of the plane at `pos` with `nl` and `nr` triangles on the two sides.
+    #[inline]
+    fn cost(&self, pos: f32, nl: usize, nr: usize) -> f32 {
+        let sa_l = self.cap + (pos - self.min) * self.ring;
+        let sa_r = self.cap + (self.max - pos) * self.ring;
+        let cost = self.c_trav + self.c_isect_per_sa * (sa_l * nl as f32 + sa_r * nr as f32);
+        if nl == 0 || nr == 0 { cost * self.empty_factor } else { cost }
     }
 }
 
@@ -255,22 +223,22 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
     }
     let b = &task.bounds;
     let sa = b.surface_area();
-    if !(sa > 0.0) {
+    if sa <= 0.0 || sa.is_nan() {
         return None;
     }
-    let inv_sa = 1.0 / sa;
     let mut best_cost = p.c_isect * task.n as f32;
     let mut best = None;
-    let mut consider = |axis: usize, pos: f32, nl: usize, np: usize, nr: usize| {
-        for (planar_left, l, r) in [(true, nl + np, nr), (false, nl, nr + np)] {
-            let c = split_cost(p, b, inv_sa, axis, pos, l, r);
+    let mut consider = |ac: &AxisCost, axis: usize, pos: f32, nl: usize, np: usize, nr: usize| {
+        let c = ac.cost(pos, nl + np, nr);
+        if c < best_cost {
+            best_cost = c;
+            best = Some(Split { axis, pos, planar_left: true });
+        }
+        if np > 0 {
+            let c = ac.cost(pos, nl, nr + np);
             if c < best_cost {
                 best_cost = c;
-                best = Some(Split {
-                    axis,
-                    pos,
-                    planar_left,
-                });
+                best = Some(Split { axis, pos, planar_left: false });
             }
         }
     };
@@ -278,9 +246,10 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
         SplitStrategy::Sah => {
             for axis in 0..3 {
                 let (lo, hi) = (b.min[axis], b.max[axis]);
-                if !(hi > lo) {
+                if hi <= lo {
                     continue;
                 }
+                let ac = AxisCost::new(p, b, axis);
                 let ev = &task.events[axis];
                 let (mut nl, mut nr) = (0usize, task.n);
                 let mut i = 0;
@@ -293,14 +262,10 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
                             i += 1;
                         }
                     }
-                    let (ne, np, ns) = (
-                        count[END as usize],
-                        count[PLANAR as usize],
-                        count[START as usize],
-                    );
+                    let (ne, np, ns) = (count[END as usize], count[PLANAR as usize], count[START as usize]);
                     nr -= ne + np;
                     if pos > lo && pos < hi {
-                        consider(axis, pos, nl, np, nr);
+                        consider(&ac, axis, pos, nl, np, nr);
                     }
                     nl += ns + np;
                 }
@@ -321,7 +286,7 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
                         _ => {}
                     }
                 }
-                consider(axis, pos, nl, np, nr);
+                consider(&AxisCost::new(p, b, axis), axis, pos, nl, np, nr);
             }
         }
     }
@@ -331,16 +296,13 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
 /// Distributes the node's events to its children (Wald and Havran 2006, section 4.3).
 fn partition(ctx: &Ctx, task: Task, split: &Split, side: &mut [u8]) -> (Task, Task) {
     let (axis, pos) = (split.axis, split.pos);
-    for e in &task.events[axis] {
-        if e.kind() != END {
-            side[e.tri()] = BOTH;
-        }
-    }
+    // One sweep classifies every triangle: a start event comes before its end event, so the start sets the
+    // side to right-only or both, and the end turns "both" into left-only when it lies at or before `pos`.
     for e in &task.events[axis] {
         let s = &mut side[e.tri()];
         match e.kind() {
+            START => *s = if e.pos >= pos { RIGHT } else { BOTH },
             END if e.pos <= pos => *s = LEFT,
-            START if e.pos >= pos => *s = RIGHT,
             PLANAR if e.pos < pos || (e.pos == pos && split.planar_left) => *s = LEFT,
             PLANAR => *s = RIGHT,
             _ => {}
@@ -379,54 +341,43 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, side: &mut [u8]) -> (Task, Ta
     let mut left: Events = Default::default();
     let mut right: Events = Default::default();
     for a in 0..3 {
-        let old = &task.events[a];
-        let (mut ol, mut or) = (Vec::with_capacity(old.len()), Vec::with_capacity(old.len()));
-        for &e in old {
-            match side[e.tri()] {
-                LEFT => ol.push(e),
-                RIGHT => or.push(e),
-                _ => {}
-            }
-        }
         new_l[a].sort_unstable_by_key(|e| e.key());
         new_r[a].sort_unstable_by_key(|e| e.key());
-        left[a] = merge(ol, &new_l[a]);
-        right[a] = merge(or, &new_r[a]);
+        (left[a], right[a]) = split_events(&task.events[a], side, &new_l[a], &new_r[a]);
     }
     let depth = task.depth + 1;
-    (
-        Task {
-            bounds: lb,
-            events: left,
-            n: nl,
-            depth,
-        },
-        Task {
-            bounds: rb,
-            events: right,
-            n: nr,
-            depth,
-        },
-    )
+    (Task { bounds: lb, events: left, n: nl, depth }, Task { bounds: rb, events: right, n: nr, depth })
 }
 
-/// Merges two lists sorted by [`Event::key`].
-fn merge(a: Vec<Event>, b: &[Event]) -> Vec<Event> {
-    if b.is_empty() {
-        return a;
-    }
-    let mut out = Vec::with_capacity(a.len() + b.len());
+/// Sends each event of `old` to the side of its triangle (dropping the straddlers' old events) and merges in
+/// the straddlers' new, sorted events, in one pass that keeps both outputs sorted by [`Event::key`].
+fn split_events(old: &[Event], side: &[u8], new_l: &[Event], new_r: &[Event]) -> (Vec<Event>, Vec<Event>) {
+    let n_left = old.iter().filter(|e| side[e.tri()] == LEFT).count();
+    let n_right = old.iter().filter(|e| side[e.tri()] == RIGHT).count();
+    let mut left = Vec::with_capacity(n_left + new_l.len());
+    let mut right = Vec::with_capacity(n_right + new_r.len());
     let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        if a[i].key() <= b[j].key() {
-            out.push(a[i]);
-            i += 1;
-        } else {
-            out.push(b[j]);
-            j += 1;
+    for &e in old {
+        let key = e.key();
+        match side[e.tri()] {
+            LEFT => {
+                while i < new_l.len() && new_l[i].key() < key {
+                    left.push(new_l[i]);
+                    i += 1;
+                }
+                left.push(e);
+            }
+            RIGHT => {
+                while j < new_r.len() && new_r[j].key() < key {
+                    right.push(new_r[j]);
+                    j += 1;
+                }
+                right.push(e);
+            }
+            _ => {}
         }
     }
-    out.extend_from_slice(&a[i..]);
-    out.extend_from_slice(&b[j..]);
-    out
+    left.extend_from_slice(&new_l[i..]);
+    right.extend_from_slice(&new_r[j..]);
+    (left, right)
 }

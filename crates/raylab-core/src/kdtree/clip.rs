@@ -18,12 +18,16 @@ pub fn clipped_bounds(tri: &[glam::Vec3; 3], bx: &Aabb) -> Option<Aabb> {
         *p = v.as_dvec3();
     }
     let mut n = 3;
+    let own = Aabb::from_points(tri.iter().copied());
     let (lo, hi) = (bx.min.as_dvec3(), bx.max.as_dvec3());
+    // Only the planes the triangle crosses can cut it; most small triangles cross just the split plane.
     for axis in 0..3 {
-        n = clip_plane(&poly[..n], &mut tmp, axis, lo[axis], true);
-        n = clip_plane(&tmp[..n], &mut poly, axis, hi[axis], false);
-        if n == 0 {
-            break;
+        for (lower, plane) in [(true, lo[axis]), (false, hi[axis])] {
+            let crosses = if lower { (own.min[axis] as f64) < plane } else { (own.max[axis] as f64) > plane };
+            if crosses && n > 0 {
+                n = clip_plane(&poly[..n], &mut tmp, axis, plane, lower);
+                poly[..n].copy_from_slice(&tmp[..n]);
+            }
         }
     }
     if n == 0 {
@@ -55,19 +59,9 @@ fn round_up(x: f64) -> f32 {
 
 /// Keeps the part of `input` on the inner side of `coord[axis] = plane` (`>=` for a lower plane, `<=` for an
 /// upper one); returns the number of vertices written to `out`.
-fn clip_plane(
-    input: &[DVec3],
-    out: &mut [DVec3; 9],
-    axis: usize,
-    plane: f64,
-    lower: bool,
-) -> usize {
+fn clip_plane(input: &[DVec3], out: &mut [DVec3; 9], axis: usize, plane: f64, lower: bool) -> usize {
     let inside = |p: &DVec3| {
-        if lower {
-            p[axis] >= plane
-        } else {
-            p[axis] <= plane
-        }
+        if lower { p[axis] >= plane } else { p[axis] <= plane }
     };
     let mut n = 0;
     for i in 0..input.len() {
@@ -96,11 +90,7 @@ mod tests {
     #[test]
     fn clipping_tightens_bounds() {
         // The triangle's own box spans y in [0, 2]; clipped to x <= 0.5 only y in [0, 1] remains.
-        let tri = [
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(1.0, 2.0, 0.0),
-            Vec3::new(0.0, 0.0, 1.0),
-        ];
+        let tri = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 0.0), Vec3::new(0.0, 0.0, 1.0)];
         let bx = Aabb::new(Vec3::splat(-1.0), Vec3::new(0.5, 3.0, 3.0));
         let b = clipped_bounds(&tri, &bx).unwrap();
         assert!((b.max.y - 1.0).abs() < 1e-6 && b.max.x == 0.5, "{b:?}");

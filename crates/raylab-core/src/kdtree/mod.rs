@@ -68,25 +68,16 @@ impl KdTree {
         let start = Instant::now();
         let tris = TriangleSoup::from_scene(scene);
         if tris.len() > MAX_INDEX {
-            return Err(KdBuildError::TooLarge {
-                what: "triangles",
-                count: tris.len(),
-            });
+            return Err(KdBuildError::TooLarge { what: "triangles", count: tris.len() });
         }
         let scene_bounds = scene.bounds();
         let out = if tris.is_empty() {
-            build::BuildOutput {
-                nodes: vec![BuildNode::Leaf { first: 0, count: 0 }],
-                tri_ids: vec![],
-            }
+            build::BuildOutput { nodes: vec![BuildNode::Leaf { first: 0, count: 0 }], tri_ids: vec![] }
         } else {
             build::build(tris.as_slice(), scene_bounds, params)
         };
         if out.nodes.len() > MAX_INDEX || out.tri_ids.len() > MAX_INDEX {
-            return Err(KdBuildError::TooLarge {
-                what: "nodes or triangle references",
-                count: out.nodes.len(),
-            });
+            return Err(KdBuildError::TooLarge { what: "nodes or triangle references", count: out.nodes.len() });
         }
         // The builder puts every child pair at an odd index; one padding node after the root moves them to
         // even indices, so a pair fills one aligned 16-byte block and `far = near ^ 1`.
@@ -94,28 +85,15 @@ impl KdTree {
         let mut nodes: Vec<KdNode> = Vec::with_capacity(out.nodes.len() + 1);
         for (i, n) in out.nodes.iter().enumerate() {
             nodes.push(match *n {
-                BuildNode::Inner { axis, split, left } => {
-                    KdNode::inner(axis as usize, split, shift(left))
-                }
+                BuildNode::Inner { axis, split, left } => KdNode::inner(axis as usize, split, shift(left)),
                 BuildNode::Leaf { first, count } => KdNode::leaf(first, count),
             });
             if i == 0 {
                 nodes.push(KdNode::leaf(0, 0));
             }
         }
-        let bounds = if tris.is_empty() {
-            Aabb::EMPTY
-        } else {
-            scene_bounds.padded(Self::ROOT_PADDING)
-        };
-        Ok(Self {
-            nodes,
-            tri_ids: out.tri_ids,
-            tris,
-            bounds,
-            params: *params,
-            build_time: start.elapsed(),
-        })
+        let bounds = if tris.is_empty() { Aabb::EMPTY } else { scene_bounds.padded(Self::ROOT_PADDING) };
+        Ok(Self { nodes, tri_ids: out.tri_ids, tris, bounds, params: *params, build_time: start.elapsed() })
     }
 
     /// The nodes; the root is node 0.

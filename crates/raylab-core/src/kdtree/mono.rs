@@ -51,12 +51,7 @@ impl KdTree {
                 tests += 1;
                 if let Some(h) = shear.intersect(self.triangles().get(id), ray.tmin, best_t) {
                     best_t = h.t;
-                    best = Some(Hit {
-                        t: h.t,
-                        tri: id,
-                        u: h.u,
-                        v: h.v,
-                    });
+                    best = Some(Hit { t: h.t, tri: id, u: h.u, v: h.v });
                 }
             }
             Next::Continue(best_t)
@@ -73,10 +68,7 @@ impl KdTree {
         self.traverse(ray, stats, |ids, _, _| {
             for &id in &self.tri_ids()[ids] {
                 tests += 1;
-                if shear
-                    .intersect(self.triangles().get(id), ray.tmin, ray.tmax)
-                    .is_some()
-                {
+                if shear.intersect(self.triangles().get(id), ray.tmin, ray.tmax).is_some() {
                     hit = true;
                     return Next::Stop;
                 }
@@ -89,28 +81,19 @@ impl KdTree {
 
     /// Walks the leaves that `ray` crosses, front to back, calling `leaf(ids, t_near, t_far)` for each.
     #[inline(always)]
-    fn traverse(
-        &self,
-        ray: &Ray,
-        stats: &mut TraversalStats,
-        mut leaf: impl FnMut(Range<usize>, f32, f32) -> Next,
-    ) {
+    fn traverse(&self, ray: &Ray, stats: &mut TraversalStats, mut leaf: impl FnMut(Range<usize>, f32, f32) -> Next) {
         stats.rays += 1;
         if self.triangles().is_empty() || !ray.is_valid() {
             return;
         }
         let inv = ray.inv_dir();
-        let Some((mut t_near, mut t_far)) =
-            self.bounds().clip_ray(ray.origin, inv, ray.tmin, ray.tmax)
-        else {
+        let Some((mut t_near, mut t_far)) = self.bounds().clip_ray(ray.origin, inv, ray.tmin, ray.tmax) else {
             return;
         };
         let origin = ray.origin.to_array();
         let inv = inv.to_array();
         // Bit k is set when the direction is negative on axis k; then the right child is the near one.
-        let neg = inv.iter().enumerate().fold(0usize, |m, (k, v)| {
-            m | ((v.is_sign_negative() as usize) << k)
-        });
+        let neg = inv.iter().enumerate().fold(0usize, |m, (k, v)| m | ((v.is_sign_negative() as usize) << k));
         let nodes = self.nodes();
         let mut stack = [Entry::default(); STACK];
         let mut sp = 0usize;
@@ -129,11 +112,7 @@ impl KdTree {
                 } else if t_split < t_near * (1.0 - SPLIT_SLACK) {
                     node = far;
                 } else {
-                    stack[sp] = Entry {
-                        node: far as u32,
-                        t_near: t_split.max(t_near),
-                        t_far,
-                    };
+                    stack[sp] = Entry { node: far as u32, t_near: t_split.max(t_near), t_far };
                     sp += 1;
                     t_far = t_split.min(t_far);
                     node = near;

@@ -24,19 +24,13 @@ impl KdNode {
     /// An inner node splitting `axis` at `split`, with children `left` and `left + 1`.
     pub fn inner(axis: usize, split: f32, left: u32) -> Self {
         debug_assert!(axis < 3 && left as usize <= MAX_INDEX);
-        Self {
-            word: (left << 2) | axis as u32,
-            data: split.to_bits(),
-        }
+        Self { word: (left << 2) | axis as u32, data: split.to_bits() }
     }
 
     /// A leaf holding `count` triangle ids from `first`.
     pub fn leaf(first: u32, count: u32) -> Self {
         debug_assert!(first as usize <= MAX_INDEX);
-        Self {
-            word: (first << 2) | 3,
-            data: count,
-        }
+        Self { word: (first << 2) | 3, data: count }
     }
 
     /// True for leaves.

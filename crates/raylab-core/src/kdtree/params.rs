@@ -61,22 +61,13 @@ impl KdParams {
     /// Checks the values are usable; returns a message naming the bad field.
     pub fn validate(&self) -> Result<(), String> {
         if !(self.c_trav.is_finite() && self.c_trav > 0.0) {
-            return Err(format!(
-                "c_trav must be finite and > 0, got {}",
-                self.c_trav
-            ));
+            return Err(format!("c_trav must be finite and > 0, got {}", self.c_trav));
         }
         if !(self.c_isect.is_finite() && self.c_isect > 0.0) {
-            return Err(format!(
-                "c_isect must be finite and > 0, got {}",
-                self.c_isect
-            ));
+            return Err(format!("c_isect must be finite and > 0, got {}", self.c_isect));
         }
         if !(0.0..1.0).contains(&self.empty_bonus) {
-            return Err(format!(
-                "empty_bonus must be in [0, 1), got {}",
-                self.empty_bonus
-            ));
+            return Err(format!("empty_bonus must be in [0, 1), got {}", self.empty_bonus));
         }
         Ok(())
     }

@@ -35,18 +35,11 @@ impl KdStats {
     pub(super) fn gather(tree: &KdTree) -> Self {
         let p = tree.params();
         let root_sa = tree.bounds().surface_area() as f64;
-        let mut s = KdStats {
-            build_seconds: tree.build_time().as_secs_f64(),
-            ..Default::default()
-        };
+        let mut s = KdStats { build_seconds: tree.build_time().as_secs_f64(), ..Default::default() };
         tree.visit(|depth, b, n| {
             s.nodes += 1;
             s.max_depth = s.max_depth.max(depth);
-            let w = if root_sa > 0.0 {
-                b.surface_area() as f64 / root_sa
-            } else {
-                0.0
-            };
+            let w = if root_sa > 0.0 { b.surface_area() as f64 / root_sa } else { 0.0 };
             if n.is_leaf() {
                 let c = n.leaf_range().len();
                 s.leaves += 1;
@@ -62,11 +55,7 @@ impl KdStats {
             }
         });
         let full = s.leaves - s.empty_leaves;
-        s.avg_tris_per_leaf = if full == 0 {
-            0.0
-        } else {
-            s.tri_refs as f64 / full as f64
-        };
+        s.avg_tris_per_leaf = if full == 0 { 0.0 } else { s.tri_refs as f64 / full as f64 };
         s.bytes = s.nodes * std::mem::size_of::<super::KdNode>() + s.tri_refs * 4;
         s
     }

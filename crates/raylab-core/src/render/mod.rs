@@ -32,13 +32,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self {
-            width: 512,
-            height: 512,
-            tile: 16,
-            order: RayOrder::Scanline,
-            shadows: true,
-        }
+        Self { width: 512, height: 512, tile: 16, order: RayOrder::Scanline, shadows: true }
     }
 }
 
@@ -55,6 +49,9 @@ pub struct Frame {
     pub stats: TraversalStats,
 }
 
+/// A finished tile: (pixel index, colour) pairs and its counters.
+type TileResult = (Vec<(u32, [u8; 4])>, TraversalStats);
+
 /// Renders `scene` from `camera` lit by `light`, tracing with `tracer`. The work runs on the current rayon
 /// pool (install a pool to choose the thread count).
 pub fn render(
@@ -68,23 +65,12 @@ pub fn render(
     let tile = settings.tile.max(1);
     let raster = camera.raster(w, h);
     let bounds = scene.bounds();
-    let epsilon = if bounds.is_empty() {
-        0.0
-    } else {
-        1e-4 * bounds.diagonal()
-    };
-    let ctx = ShadeContext {
-        scene,
-        tracer,
-        light,
-        shadows: settings.shadows,
-        epsilon,
-    };
+    let epsilon = if bounds.is_empty() { 0.0 } else { 1e-4 * bounds.diagonal() };
+    let ctx = ShadeContext { scene, tracer, light, shadows: settings.shadows, epsilon };
     let offsets = settings.order.offsets(tile, tile);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(tile))
-        .flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile)))
-        .collect();
-    let done: Vec<(Vec<(u32, [u8; 4])>, TraversalStats)> = tiles
+    let tiles: Vec<(u32, u32)> =
+        (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
+    let done: Vec<TileResult> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             let mut stats = TraversalStats::default();
@@ -99,10 +85,7 @@ pub fn render(
                     Some(hit) => ctx.shade(&ray, &hit, &mut stats),
                     None => Vec3::ZERO,
                 };
-                px.push((
-                    y * w + x,
-                    [to_display(c.x), to_display(c.y), to_display(c.z), 255],
-                ));
+                px.push((y * w + x, [to_display(c.x), to_display(c.y), to_display(c.z), 255]));
             }
             (px, stats)
         })
@@ -115,10 +98,5 @@ pub fn render(
         }
         stats += s;
     }
-    Frame {
-        width: w,
-        height: h,
-        rgba,
-        stats,
-    }
+    Frame { width: w, height: h, rgba, stats }
 }

@@ -39,10 +39,7 @@ impl RayOrder {
         match self {
             RayOrder::Scanline => (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).collect(),
             RayOrder::Morton => (0..side * side).map(morton_decode).filter(inside).collect(),
-            RayOrder::Hilbert => (0..side * side)
-                .map(|d| hilbert_decode(side, d))
-                .filter(inside)
-                .collect(),
+            RayOrder::Hilbert => (0..side * side).map(|d| hilbert_decode(side, d)).filter(inside).collect(),
         }
     }
 }
@@ -120,9 +117,6 @@ mod tests {
             let d = p[0].0.abs_diff(p[1].0) + p[0].1.abs_diff(p[1].1);
             assert_eq!(d, 1, "{:?}", p);
         }
-        assert_eq!(
-            RayOrder::Morton.offsets(4, 4)[..4],
-            [(0, 0), (1, 0), (0, 1), (1, 1)]
-        );
+        assert_eq!(RayOrder::Morton.offsets(4, 4)[..4], [(0, 0), (1, 0), (0, 1), (1, 1)]);
     }
 }

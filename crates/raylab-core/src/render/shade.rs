@@ -41,8 +41,7 @@ impl ShadeContext<'_> {
         if n.dot(ng) < 0.0 {
             n = -n;
         }
-        let material =
-            &self.scene.materials[self.scene.triangles[hit.tri as usize].material as usize];
+        let material = &self.scene.materials[self.scene.triangles[hit.tri as usize].material as usize];
         let p = ray.at(hit.t);
         let to_light = self.light.position - p;
         let dist = to_light.length();

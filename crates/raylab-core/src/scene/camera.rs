@@ -62,14 +62,7 @@ impl Camera {
     /// A pinhole camera.
     pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, vfov_deg: f32) -> Self {
         let focus_distance = (target - eye).length().max(1e-3);
-        Self {
-            eye,
-            target,
-            up,
-            vfov_deg,
-            aperture: 0.0,
-            focus_distance,
-        }
+        Self { eye, target, up, vfov_deg, aperture: 0.0, focus_distance }
     }
 
     /// Checks that the camera defines a proper basis.
@@ -98,14 +91,7 @@ impl Camera {
         let u = r.cross(f);
         let s = (self.vfov_deg as f64 * std::f64::consts::PI / 360.0).tan();
         let aspect = width as f64 / height as f64;
-        CameraRaster {
-            eye: self.eye,
-            f,
-            r: r * (s * aspect),
-            u: u * s,
-            width: width as f64,
-            height: height as f64,
-        }
+        CameraRaster { eye: self.eye, f, r: r * (s * aspect), u: u * s, width: width as f64, height: height as f64 }
     }
 }
 
@@ -157,33 +143,9 @@ mod tests {
     fn validate_rejects_bad_cameras() {
         let ok = Camera::look_at(Vec3::ZERO, Vec3::X, Vec3::Y, 60.0);
         assert_eq!(ok.validate(), Ok(()));
-        assert_eq!(
-            Camera {
-                vfov_deg: 180.0,
-                ..ok
-            }
-            .validate(),
-            Err(CameraError::Fov)
-        );
-        assert_eq!(
-            Camera {
-                target: Vec3::ZERO,
-                ..ok
-            }
-            .validate(),
-            Err(CameraError::NoViewDirection)
-        );
-        assert_eq!(
-            Camera { up: Vec3::X, ..ok }.validate(),
-            Err(CameraError::UpParallel)
-        );
-        assert_eq!(
-            Camera {
-                eye: Vec3::NAN,
-                ..ok
-            }
-            .validate(),
-            Err(CameraError::NotFinite)
-        );
+        assert_eq!(Camera { vfov_deg: 180.0, ..ok }.validate(), Err(CameraError::Fov));
+        assert_eq!(Camera { target: Vec3::ZERO, ..ok }.validate(), Err(CameraError::NoViewDirection));
+        assert_eq!(Camera { up: Vec3::X, ..ok }.validate(), Err(CameraError::UpParallel));
+        assert_eq!(Camera { eye: Vec3::NAN, ..ok }.validate(), Err(CameraError::NotFinite));
     }
 }

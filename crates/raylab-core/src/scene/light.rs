@@ -26,14 +26,7 @@ pub struct PointLight {
 impl PointLight {
     /// A white light at `position` with no attenuation (the Embree harness's light) and radius zero.
     pub fn at(position: Vec3) -> Self {
-        Self {
-            position,
-            color: Vec3::ONE,
-            constant: 1.0,
-            linear: 0.0,
-            quadratic: 0.0,
-            radius: 0.0,
-        }
+        Self { position, color: Vec3::ONE, constant: 1.0, linear: 0.0, quadratic: 0.0, radius: 0.0 }
     }
 
     /// The attenuation factor at distance `d`, clamped to at most 1.

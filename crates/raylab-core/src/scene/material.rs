@@ -1,7 +1,7 @@
 //! Fixed-function materials (Tsakok 2008, section 4.2.1, Listing 4.7).
 //!
-//! RTTest exposes five shader types, each adding one effect to the previous: diffuse, + Phong specular,
-//! + mirror reflection, and two transparent types. raylab keeps the same five types and the same parameters,
+//! RTTest exposes five shader types, each adding one effect to the previous: diffuse, then a Phong
+//! highlight, then mirror reflection, and two transparent types. raylab keeps the same five types and the same parameters,
 //! flattened into one struct so the shader reads them without branching on nested records; the fields a
 //! type does not use are ignored.
 
@@ -39,10 +39,7 @@ impl MaterialKind {
 
     /// True for the kinds that show a Phong highlight.
     pub fn has_specular(self) -> bool {
-        matches!(
-            self,
-            Self::Specular | Self::Reflective | Self::TransparentReflective
-        )
+        matches!(self, Self::Specular | Self::Reflective | Self::TransparentReflective)
     }
 
     /// True for the kinds that spawn a reflection ray.
@@ -104,26 +101,12 @@ impl Default for Material {
 impl Material {
     /// A named diffuse material of the given colour.
     pub fn diffuse(name: &str, base_color: Vec3) -> Self {
-        Self {
-            name: name.into(),
-            base_color,
-            ..Self::default()
-        }
+        Self { name: name.into(), base_color, ..Self::default() }
     }
 
     /// A diffuse material with a Phong highlight.
-    pub fn specular(
-        name: &str,
-        base_color: Vec3,
-        phong_exponent: f32,
-        specular_blend: f32,
-    ) -> Self {
-        Self {
-            kind: MaterialKind::Specular,
-            phong_exponent,
-            specular_blend,
-            ..Self::diffuse(name, base_color)
-        }
+    pub fn specular(name: &str, base_color: Vec3, phong_exponent: f32, specular_blend: f32) -> Self {
+        Self { kind: MaterialKind::Specular, phong_exponent, specular_blend, ..Self::diffuse(name, base_color) }
     }
 
     /// A mirror-like material reflecting `reflect_blend` of the incoming light.

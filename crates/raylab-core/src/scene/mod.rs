@@ -82,11 +82,7 @@ impl Scene {
     #[inline]
     pub fn vertices(&self, i: usize) -> [Vec3; 3] {
         let t = &self.triangles[i];
-        [
-            self.positions[t.v[0] as usize],
-            self.positions[t.v[1] as usize],
-            self.positions[t.v[2] as usize],
-        ]
+        [self.positions[t.v[0] as usize], self.positions[t.v[1] as usize], self.positions[t.v[2] as usize]]
     }
 
     /// Bounds of triangle `i`.
@@ -206,11 +202,8 @@ impl SceneBuilder {
                 }
             }
         }
-        let bounds = self
-            .triangles
-            .iter()
-            .flat_map(|t| t.v)
-            .fold(Aabb::EMPTY, |b, i| b.grow(self.positions[i as usize]));
+        let bounds =
+            self.triangles.iter().flat_map(|t| t.v).fold(Aabb::EMPTY, |b, i| b.grow(self.positions[i as usize]));
         Scene {
             positions: self.positions,
             normals: self.normals,
@@ -233,50 +226,18 @@ mod tests {
     #[test]
     fn builder_drops_bad_triangles_and_counts_them() {
         let mut b = SceneBuilder::new();
-        b.positions = vec![
-            Vec3::ZERO,
-            Vec3::X,
-            Vec3::Y,
-            Vec3::new(2.0, 0.0, 0.0),
-            Vec3::new(f32::NAN, 0.0, 0.0),
-        ];
+        b.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(2.0, 0.0, 0.0), Vec3::new(f32::NAN, 0.0, 0.0)];
         b.triangles = vec![
-            Triangle {
-                v: [0, 1, 2],
-                material: 0,
-            },
-            Triangle {
-                v: [0, 1, 3],
-                material: 0,
-            }, // collinear
-            Triangle {
-                v: [0, 1, 4],
-                material: 0,
-            }, // NaN vertex
-            Triangle {
-                v: [0, 1, 9],
-                material: 0,
-            }, // out of range
-            Triangle {
-                v: [0, 0, 2],
-                material: 0,
-            }, // repeated vertex
+            Triangle { v: [0, 1, 2], material: 0 },
+            Triangle { v: [0, 1, 3], material: 0 }, // collinear
+            Triangle { v: [0, 1, 4], material: 0 }, // NaN vertex
+            Triangle { v: [0, 1, 9], material: 0 }, // out of range
+            Triangle { v: [0, 0, 2], material: 0 }, // repeated vertex
         ];
         let s = b.build();
         assert_eq!(s.triangle_count(), 1);
-        assert_eq!(
-            s.dropped,
-            DroppedTriangles {
-                bad_index: 1,
-                non_finite: 1,
-                degenerate: 2
-            }
-        );
-        assert_eq!(
-            s.materials.len(),
-            1,
-            "a default material is added for the orphan index"
-        );
+        assert_eq!(s.dropped, DroppedTriangles { bad_index: 1, non_finite: 1, degenerate: 2 });
+        assert_eq!(s.materials.len(), 1, "a default material is added for the orphan index");
         assert_eq!(s.bounds(), Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
         assert_eq!(s.geometric_normal(0), Vec3::Z);
     }

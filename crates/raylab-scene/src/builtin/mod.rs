@@ -70,8 +70,5 @@ pub fn names() -> Vec<&'static str> {
 
 /// Builds the built-in scene `name`, or `None` if there is none of that name.
 pub fn build(name: &str, detail: Detail) -> Option<Scene> {
-    BUILTINS
-        .iter()
-        .find(|b| b.name == name)
-        .map(|b| (b.build)(detail))
+    BUILTINS.iter().find(|b| b.name == name).map(|b| (b.build)(detail))
 }

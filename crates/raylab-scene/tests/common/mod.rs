@@ -28,10 +28,7 @@ pub fn check_hits(scene: &Scene, method: &dyn Intersector, rays: &[Ray], what: &
                 let close = (g.t - w.t).abs() <= T_REL_TOL * w.t.abs().max(1e-30);
                 let same_tri = g.tri == w.tri;
                 let tie = close && reference.hit_distance(ray, g.tri).is_some_and(|t| t == g.t);
-                assert!(
-                    close && (same_tri || tie),
-                    "{what}: ray {i} {ray:?}: got {g:?}, reference {w:?}"
-                );
+                assert!(close && (same_tri || tie), "{what}: ray {i} {ray:?}: got {g:?}, reference {w:?}");
             }
             _ => panic!("{what}: ray {i} {ray:?}: got {got:?}, reference {want:?}"),
         }
@@ -49,13 +46,7 @@ pub fn adversarial_rays(scene: &Scene, tree: &KdTree, n: usize, seed: u32) -> Ve
     let b = scene.bounds();
     let pad = b.extent() * 0.2;
     let (lo, hi) = (b.min - pad, b.max + pad);
-    let mut point = |rng: &mut Jitter| {
-        Vec3::new(
-            rng.range(lo.x, hi.x),
-            rng.range(lo.y, hi.y),
-            rng.range(lo.z, hi.z),
-        )
-    };
+    let point = |rng: &mut Jitter| Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
     let mut rays = Vec::new();
     let axis_dirs = [
         Vec3::X,
@@ -72,24 +63,13 @@ pub fn adversarial_rays(scene: &Scene, tree: &KdTree, n: usize, seed: u32) -> Ve
     ];
     for k in 0..n {
         let o = point(&mut rng);
-        let random_dir = Vec3::new(
-            rng.range(-1.0, 1.0),
-            rng.range(-1.0, 1.0),
-            rng.range(-1.0, 1.0),
-        );
+        let random_dir = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
         rays.push(Ray::new(o, random_dir));
         rays.push(Ray::new(o, axis_dirs[k % axis_dirs.len()]));
         if scene.triangle_count() > 0 {
-            let t = (rng.next() * scene.triangle_count() as f32) as usize % scene.triangle_count();
+            let t = (rng.unit() * scene.triangle_count() as f32) as usize % scene.triangle_count();
             let [a, bb, c] = scene.vertices(t);
-            let targets = [
-                a,
-                bb,
-                c,
-                (a + bb) * 0.5,
-                (bb + c) * 0.5,
-                (a + c) / 3.0 + bb / 3.0 + c / 3.0,
-            ];
+            let targets = [a, bb, c, (a + bb) * 0.5, (bb + c) * 0.5, (a + c) / 3.0 + bb / 3.0 + c / 3.0];
             let target = targets[k % targets.len()];
             rays.push(Ray::new(o, target - o));
             // Grazing: start on the triangle's plane and run along it toward an edge and past a vertex.
@@ -111,11 +91,7 @@ pub fn adversarial_rays(scene: &Scene, tree: &KdTree, n: usize, seed: u32) -> Ve
     for (k, (axis, split)) in splits.into_iter().enumerate() {
         let mut o = point(&mut rng);
         o[axis] = split;
-        let mut d = Vec3::new(
-            rng.range(-1.0, 1.0),
-            rng.range(-1.0, 1.0),
-            rng.range(-1.0, 1.0),
-        );
+        let mut d = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
         d[axis] = if k % 2 == 0 { 0.0 } else { -0.0 };
         rays.push(Ray::new(o, d));
     }

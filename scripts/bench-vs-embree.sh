@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Builds the Embree harness from ../shared/tools/embree-bench (needs g++ and libembree-dev) and regenerates the
+# single-ray table of docs/BENCHMARKS.md with `raylab-bench compare`, which runs Embree and raylab on the same
+# OBJ, view, light and rays in one invocation. Run it on a committed tree: the table records the commit.
+#
+#   scripts/bench-vs-embree.sh            # 512x512, threads 1 and 2, 7 timed runs each
+#   REPS=3 scripts/bench-vs-embree.sh
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+shared=${SHARED:-$root/../shared}
+reps=${REPS:-7}
+harness=$root/target/embree-bench
+mkdir -p "$harness"
+cp "$shared/tools/embree-bench/embree_bench.cpp" "$shared/tools/embree-bench/Makefile" "$harness/"
+make -s -C "$harness" embree_bench
+cargo build --release -p raylab-bench --manifest-path "$root/Cargo.toml"
+
+cd "$root"
+table=$(mktemp)
+target/release/raylab-bench compare --embree target/embree-bench/embree_bench \
+  --scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 --target 10,5.5,0 --up 0,1,0 --fov 65 \
+  --light 0,11,0 --width 512 --height 512 --threads 1,2 --reps "$reps" --warmup 1 --builds 3 --markdown "$table"
+
+# Replace the text between the markers in docs/BENCHMARKS.md with the fresh table.
+awk -v table="$table" '
+  /<!-- mono-vs-embree:begin -->/ { print; while ((getline line < table) > 0) print line; skip = 1; next }
+  /<!-- mono-vs-embree:end -->/ { skip = 0 }
+  !skip { print }
+' docs/BENCHMARKS.md > docs/BENCHMARKS.md.new
+mv docs/BENCHMARKS.md.new docs/BENCHMARKS.md
+rm -f "$table"
+echo "updated docs/BENCHMARKS.md"
