@@ -112,9 +112,12 @@ impl KdTree {
                 } else if t_split < t_near * (1.0 - SPLIT_SLACK) {
                     node = far;
                 } else {
-                    stack[sp] = Entry { node: far as u32, t_near: t_split.max(t_near), t_far };
+                    // Plain selects rather than `f32::max`/`min`: a NaN split distance (ray inside the plane)
+                    // keeps the current bounds, as it must, and each compiles to one `maxss`/`minss`.
+                    let far_near = if t_split > t_near { t_split } else { t_near };
+                    stack[sp] = Entry { node: far as u32, t_near: far_near, t_far };
                     sp += 1;
-                    t_far = t_split.min(t_far);
+                    t_far = if t_split < t_far { t_split } else { t_far };
                     node = near;
                 }
                 continue;
