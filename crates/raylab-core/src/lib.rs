@@ -11,11 +11,13 @@
 pub mod aabb;
 pub mod kdtree;
 pub mod method;
+pub mod packet;
 pub mod ray;
 pub mod reference;
 pub mod render;
 pub mod scene;
 pub mod stats;
+pub mod trace;
 pub mod triangle;
 pub mod workload;
 

@@ -17,20 +17,34 @@ pub enum Method {
     /// One ray at a time through the kd-tree (thesis Listing 2.2).
     #[default]
     Mono,
+    /// Omni-directional 2x2 ray packets (thesis 4.1.2, Listing 4.1).
+    Packet,
+    /// One frustum per tile with interval traversal and packet/leaf culling (Listing 4.2, 4.1.3-4.1.4).
+    Frustum,
+    /// Multiple Frustum Traversal: four quadrant frustums per tile in SIMD lanes (thesis 4.1.5).
+    Mft,
     /// Every ray against every triangle; for testing only.
     Reference,
 }
 
 impl Method {
     /// All methods, in the order menus list them.
-    pub const ALL: [Method; 2] = [Method::Mono, Method::Reference];
+    pub const ALL: [Method; 5] = [Method::Mono, Method::Packet, Method::Frustum, Method::Mft, Method::Reference];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Method::Mono => "mono",
+            Method::Packet => "packet",
+            Method::Frustum => "frustum",
+            Method::Mft => "mft",
             Method::Reference => "reference",
         }
+    }
+
+    /// True for the methods whose cost depends on the tile size (frustums).
+    pub fn uses_tiles(self) -> bool {
+        matches!(self, Method::Frustum | Method::Mft)
     }
 }
 

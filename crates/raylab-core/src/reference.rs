@@ -23,6 +23,7 @@ impl BruteForce {
     /// The closest hit in `(tmin, tmax]`; among hits at the same distance the lowest triangle id wins.
     pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
         stats.rays += 1;
+        stats.packets += 1;
         if !ray.is_valid() {
             return None;
         }
@@ -43,6 +44,7 @@ impl BruteForce {
     /// True when any triangle blocks the ray in `(tmin, tmax]`.
     pub fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
         stats.rays += 1;
+        stats.packets += 1;
         if !ray.is_valid() {
             return false;
         }

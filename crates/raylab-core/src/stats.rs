@@ -9,9 +9,9 @@ use serde::{Deserialize, Serialize};
 
 /// Work counted while tracing.
 ///
-/// `nodes` counts every kd-tree node a ray (or packet, or frustum) visits, inner nodes and leaves alike; this
-/// is the thesis's N once divided by the number of packets. `isect_tests` counts triangle tests (the thesis's
-/// I, likewise). For packet kernels one visit or one test by a whole packet counts once.
+/// `nodes` counts every kd-tree node a ray, packet or frustum visits, inner nodes and leaves alike, and
+/// `isect_tests` counts triangle tests; a visit or a test by a whole packet or frustum counts once. Divided by
+/// `packets` (2x2 ray packets; a single ray counts as one) they are the thesis's N and I (Table 4.1).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct TraversalStats {
     /// Rays traced.
@@ -20,8 +20,12 @@ pub struct TraversalStats {
     pub nodes: u64,
     /// Leaves visited (included in `nodes`).
     pub leaves: u64,
-    /// Ray/triangle intersection tests.
+    /// Ray/triangle intersection tests (packet/triangle tests for packet kernels).
     pub isect_tests: u64,
+    /// Packets traced: 2x2 (or 4x2) packets for coherent kernels, one per ray for single-ray kernels.
+    pub packets: u64,
+    /// Packets skipped at a leaf because none of their rays overlaps its box (thesis 4.1.4).
+    pub packets_culled: u64,
 }
 
 impl AddAssign for TraversalStats {
@@ -30,6 +34,8 @@ impl AddAssign for TraversalStats {
         self.nodes += o.nodes;
         self.leaves += o.leaves;
         self.isect_tests += o.isect_tests;
+        self.packets += o.packets;
+        self.packets_culled += o.packets_culled;
     }
 }
 
@@ -48,6 +54,16 @@ impl TraversalStats {
     pub fn isects_per_ray(&self) -> f64 {
         ratio(self.isect_tests, self.rays)
     }
+
+    /// The thesis's N: nodes visited per packet.
+    pub fn nodes_per_packet(&self) -> f64 {
+        ratio(self.nodes, self.packets)
+    }
+
+    /// The thesis's I: intersection tests per packet.
+    pub fn isects_per_packet(&self) -> f64 {
+        ratio(self.isect_tests, self.packets)
+    }
 }
 
 fn ratio(a: u64, b: u64) -> f64 {
@@ -60,8 +76,8 @@ mod tests {
 
     #[test]
     fn merge_and_ratios() {
-        let mut a = TraversalStats { rays: 2, nodes: 10, leaves: 4, isect_tests: 6 };
-        a += TraversalStats { rays: 2, nodes: 2, leaves: 0, isect_tests: 2 };
+        let mut a = TraversalStats { rays: 2, nodes: 10, leaves: 4, isect_tests: 6, packets: 2, packets_culled: 0 };
+        a += TraversalStats { rays: 2, nodes: 2, leaves: 0, isect_tests: 2, packets: 2, packets_culled: 1 };
         assert_eq!(a.nodes_per_ray(), 3.0);
         assert_eq!(a.isects_per_ray(), 2.0);
         assert_eq!(TraversalStats::default().nodes_per_ray(), 0.0);

@@ -57,6 +57,16 @@ impl RayShear {
         Self { origin: ray.origin, kx, ky, kz, sx: d[kx] * sz, sy: d[ky] * sz, sz }
     }
 
+    /// The axis the sheared ray runs along and the two others, in the order the edge functions use.
+    pub fn axes(&self) -> [usize; 3] {
+        [self.kx, self.ky, self.kz]
+    }
+
+    /// The shear constants `(S_x, S_y, S_z)` of the paper.
+    pub fn shear(&self) -> [f32; 3] {
+        [self.sx, self.sy, self.sz]
+    }
+
     /// Intersects the triangle `(p0, p1, p2)`; reports a hit with `tmin < t <= tmax` (the interval
     /// convention Embree uses, so both tracers agree on hits exactly at a segment's end).
     #[inline(always)]

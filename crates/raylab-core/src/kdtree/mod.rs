@@ -2,8 +2,11 @@
 
 mod build;
 mod clip;
+pub mod frustum;
+pub mod mft;
 pub mod mono;
 mod node;
+pub mod packet;
 mod params;
 mod stats;
 

@@ -83,6 +83,7 @@ impl KdTree {
     #[inline(always)]
     fn traverse(&self, ray: &Ray, stats: &mut TraversalStats, mut leaf: impl FnMut(Range<usize>, f32, f32) -> Next) {
         stats.rays += 1;
+        stats.packets += 1;
         if self.triangles().is_empty() || !ray.is_valid() {
             return;
         }

@@ -1,0 +1,213 @@
+//! Frustum interval traversal (Tsakok 2008, 2.3.2 and Listing 4.2 with the omni-directional changes of
+//! 4.1.2) with packet/leaf culling (4.1.4).
+//!
+//! A whole tile of rays with a common origin walks the tree as one interval `[near, far]` of distances from
+//! the origin: at a split the [`Frustum`] gives the range of distances at which its rays cross the plane,
+//! the child on the origin's side is entered first, and the other child is pushed with the part of the
+//! interval that lies beyond the earliest crossing. At a leaf, each 2x2 packet is first tested against the
+//! leaf's box (culling, switchable) and then against the leaf's triangles. Entries on the stack that start
+//! beyond every ray's closest hit are skipped, which ends the walk once all rays have hit.
+
+use raylab_simd::{VMask, Vf32};
+
+use super::mono::SPLIT_SLACK;
+use super::{KdParams, KdTree};
+use crate::aabb::Aabb;
+use crate::packet::{Frustum, PacketTile, intersect_packet, occlude_packet, overlaps_box};
+use crate::stats::TraversalStats;
+
+#[derive(Clone, Copy)]
+struct Entry {
+    node: u32,
+    near: f32,
+    far: f32,
+    bounds: Aabb,
+}
+
+const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
+
+/// The two children's boxes of `b` split on `axis` at `split`: (left, right).
+#[inline(always)]
+pub(super) fn child_boxes(b: &Aabb, axis: usize, split: f32) -> (Aabb, Aabb) {
+    let (mut l, mut r) = (*b, *b);
+    l.max[axis] = split;
+    r.min[axis] = split;
+    (l, r)
+}
+
+/// Tests the leaf `ids` with box `bounds` against packets `set` of `tile`, culling packets whose rays miss
+/// the box when `cull` is on. Returns true when some lane's closest hit changed.
+pub(super) fn leaf_intersect<V: Vf32>(
+    tree: &KdTree,
+    ids: std::ops::Range<usize>,
+    bounds: &Aabb,
+    tile: &mut PacketTile<V>,
+    set: &[usize],
+    cull: bool,
+    stats: &mut TraversalStats,
+) -> bool {
+    let ids = &tree.tri_ids()[ids];
+    if ids.is_empty() {
+        return false;
+    }
+    let mut changed = false;
+    for &j in set {
+        let p = &tile.packets[j];
+        let hits = &mut tile.hits[j];
+        let active = if cull { overlaps_box(p, bounds, hits.t, SPLIT_SLACK) } else { p.valid };
+        if active.none() {
+            stats.packets_culled += 1;
+            continue;
+        }
+        for &id in ids {
+            stats.isect_tests += 1;
+            changed |= intersect_packet(p, hits, tree.triangles().get(id), id, active).any();
+        }
+    }
+    changed
+}
+
+/// Any-hit counterpart of [`leaf_intersect`]: marks lanes blocked by the leaf's triangles in `blocked`.
+pub(super) fn leaf_occlude<V: Vf32>(
+    tree: &KdTree,
+    ids: std::ops::Range<usize>,
+    bounds: &Aabb,
+    tile: &PacketTile<V>,
+    set: &[usize],
+    cull: bool,
+    blocked: &mut [V::Mask],
+    stats: &mut TraversalStats,
+) {
+    let ids = &tree.tri_ids()[ids];
+    if ids.is_empty() {
+        return;
+    }
+    for &j in set {
+        let p = &tile.packets[j];
+        let mut open = p.valid & !blocked[j];
+        if open.none() {
+            continue;
+        }
+        if cull {
+            open = open & overlaps_box(p, bounds, p.tmax, SPLIT_SLACK);
+            if open.none() {
+                stats.packets_culled += 1;
+                continue;
+            }
+        }
+        for &id in ids {
+            stats.isect_tests += 1;
+            blocked[j] = blocked[j] | occlude_packet(p, tree.triangles().get(id), open);
+            open = open & !blocked[j];
+            if open.none() {
+                break;
+            }
+        }
+    }
+}
+
+/// The largest current hit distance over the lanes of packets `set` (infinite while any lane has none).
+pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> f32 {
+    set.iter().fold(0.0f32, |m, &j| {
+        let p = &tile.packets[j];
+        let t = V::select(p.valid, tile.hits[j].t, V::splat(0.0));
+        m.max(t.reduce_max())
+    })
+}
+
+impl KdTree {
+    /// Closest hits of the packets `set` of `tile`, whose rays share the origin of frustum `f` and lie
+    /// inside it; results accumulate in `tile.hits`.
+    pub fn intersect_frustum<V: Vf32>(
+        &self,
+        f: &Frustum,
+        tile: &mut PacketTile<V>,
+        set: &[usize],
+        cull: bool,
+        stats: &mut TraversalStats,
+    ) {
+        let mut limit = f32::INFINITY;
+        self.traverse_frustum(f, stats, |tree, ids, bounds, stats| {
+            if leaf_intersect(tree, ids, bounds, tile, set, cull, stats) {
+                limit = hit_limit(tile, set) * f.t_scale;
+            }
+            (limit, false)
+        });
+    }
+
+    /// Marks in `blocked` the lanes of packets `set` that something blocks. The frustum `f` must bound the
+    /// rays' segments (it may be built from the other end of the segments, e.g. from a light).
+    pub fn occluded_frustum<V: Vf32>(
+        &self,
+        f: &Frustum,
+        tile: &PacketTile<V>,
+        set: &[usize],
+        cull: bool,
+        blocked: &mut [V::Mask],
+        stats: &mut TraversalStats,
+    ) {
+        self.traverse_frustum(f, stats, |tree, ids, bounds, stats| {
+            leaf_occlude(tree, ids, bounds, tile, set, cull, blocked, stats);
+            let all = set.iter().all(|&j| (tile.packets[j].valid & !blocked[j]).none());
+            (f32::INFINITY, all)
+        });
+    }
+
+    /// Walks the leaves the frustum overlaps, roughly front to back. `leaf(tree, ids, box, stats)` returns
+    /// the distance beyond which no ray needs more leaves, and whether the walk can stop.
+    fn traverse_frustum(
+        &self,
+        f: &Frustum,
+        stats: &mut TraversalStats,
+        mut leaf: impl FnMut(&KdTree, std::ops::Range<usize>, &Aabb, &mut TraversalStats) -> (f32, bool),
+    ) {
+        if self.triangles().is_empty() {
+            return;
+        }
+        let nodes = self.nodes();
+        let mut stack = [Entry { node: 0, near: 0.0, far: 0.0, bounds: Aabb::EMPTY }; STACK];
+        let mut sp = 0usize;
+        let (mut node, mut near, mut far, mut bounds) = (0usize, f.t_min, f.t_max, self.bounds());
+        let (mut visited, mut leaves) = (0u64, 0u64);
+        'walk: loop {
+            let n = nodes[node];
+            visited += 1;
+            if !n.is_leaf() {
+                let (axis, split) = (n.axis(), n.split());
+                let (lo, hi) = f.crossing(axis, split);
+                let origin_right = split - f.origin[axis] < 0.0;
+                let front = n.left() | origin_right as usize;
+                let (left_box, right_box) = child_boxes(&bounds, axis, split);
+                let (front_box, back_box) = if origin_right { (right_box, left_box) } else { (left_box, right_box) };
+                if hi < near * (1.0 - SPLIT_SLACK) {
+                    (node, bounds) = (front ^ 1, back_box);
+                } else if lo > far * (1.0 + SPLIT_SLACK) {
+                    (node, bounds) = (front, front_box);
+                } else {
+                    stack[sp] = Entry { node: (front ^ 1) as u32, near: lo.max(near), far, bounds: back_box };
+                    sp += 1;
+                    (node, far, bounds) = (front, hi.min(far), front_box);
+                }
+                continue;
+            }
+            leaves += 1;
+            let (limit, stop) = leaf(self, n.leaf_range(), &bounds, stats);
+            if stop {
+                break;
+            }
+            loop {
+                if sp == 0 {
+                    break 'walk;
+                }
+                sp -= 1;
+                let e = stack[sp];
+                if e.near * (1.0 - SPLIT_SLACK) <= limit {
+                    (node, near, far, bounds) = (e.node as usize, e.near, e.far, e.bounds);
+                    break;
+                }
+            }
+        }
+        stats.nodes += visited;
+        stats.leaves += leaves;
+    }
+}

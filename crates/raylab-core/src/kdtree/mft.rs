@@ -1,0 +1,203 @@
+//! Multiple Frustum Traversal (Tsakok 2008, 4.1.5, Tables 4.3-4.4): a tile split into four quadrant
+//! frustums that walk the tree together, one SIMD lane per frustum.
+//!
+//! Each lane keeps its own interval and the frustums share every node decision, so the tree is walked once
+//! as for one large frustum; but a frustum that does not reach a child, or whose rays have all hit before
+//! the child's interval starts ("completed"), is masked out there, and its packets skip that child's
+//! leaves. The active mask is pushed with every stack entry. The per-lane interval update is the scalar
+//! one of [`super::frustum`], done for four frustums at once.
+
+use raylab_simd::{VMask, Vf32};
+
+use super::frustum::{child_boxes, hit_limit, leaf_intersect, leaf_occlude};
+use super::mono::SPLIT_SLACK;
+use super::{KdParams, KdTree};
+use crate::aabb::Aabb;
+use crate::packet::{Frustum, PacketTile};
+use crate::stats::TraversalStats;
+
+/// Four frustums with a common origin, one per SIMD lane.
+#[derive(Clone, Copy, Debug)]
+pub struct Frustum4<V: Vf32> {
+    origin: glam::Vec3,
+    pos_near: [V; 3],
+    pos_far: [V; 3],
+    neg_near: [V; 3],
+    neg_far: [V; 3],
+    t_min: V,
+    t_max: V,
+    t_scale: [f32; 4],
+    origin_slack: f32,
+    /// Lanes that hold a frustum.
+    valid: V::Mask,
+}
+
+impl<V: Vf32> Frustum4<V> {
+    /// Packs up to four frustums with the same origin; `None` entries leave a lane empty.
+    pub fn new(f: [Option<Frustum>; 4]) -> Option<Self> {
+        assert_eq!(V::LANES, 4, "MFT traces four frustums");
+        let first = f.iter().flatten().next()?;
+        let origin = first.origin;
+        assert!(f.iter().flatten().all(|x| x.origin == origin), "MFT frustums share their origin");
+        let lanes = |g: &dyn Fn(&Frustum) -> f32, empty: f32| V::from_slice(&f.map(|x| x.as_ref().map_or(empty, g)));
+        let axes =
+            |g: &dyn Fn(&Frustum, usize) -> f32, empty: f32| [0, 1, 2].map(|k| lanes(&|x: &Frustum| g(x, k), empty));
+        let valid = f.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
+        Some(Self {
+            origin,
+            pos_near: axes(&|x, k| x.pos_near[k], f32::INFINITY),
+            pos_far: axes(&|x, k| x.pos_far[k], f32::INFINITY),
+            neg_near: axes(&|x, k| x.neg_near[k], f32::NEG_INFINITY),
+            neg_far: axes(&|x, k| x.neg_far[k], f32::NEG_INFINITY),
+            t_min: lanes(&|x| x.t_min, f32::INFINITY),
+            t_max: lanes(&|x| x.t_max, f32::NEG_INFINITY),
+            t_scale: f.map(|x| x.map_or(1.0, |x| x.t_scale)),
+            origin_slack: f.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack)),
+            valid: V::Mask::from_bits(valid),
+        })
+    }
+
+    #[inline(always)]
+    fn crossing(&self, k: usize, split: f32) -> (V, V) {
+        let dist = split - self.origin[k];
+        let slack = self.origin_slack;
+        if dist > slack {
+            (V::splat(dist - slack) * self.pos_near[k], V::splat(dist + slack) * self.pos_far[k])
+        } else if dist < -slack {
+            (V::splat(dist + slack) * self.neg_near[k], V::splat(dist - slack) * self.neg_far[k])
+        } else {
+            (V::splat(0.0), V::splat(f32::INFINITY))
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Entry<V: Vf32> {
+    node: u32,
+    near: V,
+    far: V,
+    active: V::Mask,
+    bounds: Aabb,
+}
+
+const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
+
+impl KdTree {
+    /// Closest hits of the packets of `tile`; `sets[i]` lists the packets that frustum lane `i` bounds.
+    pub fn intersect_mft<V: Vf32>(
+        &self,
+        f: &Frustum4<V>,
+        tile: &mut PacketTile<V>,
+        sets: &[Vec<usize>; 4],
+        cull: bool,
+        stats: &mut TraversalStats,
+    ) {
+        let mut limit = [f32::INFINITY; 4];
+        self.traverse_mft(f, stats, |tree, ids, bounds, active, stats| {
+            for (i, set) in sets.iter().enumerate() {
+                if active >> i & 1 == 1 && leaf_intersect(tree, ids.clone(), bounds, tile, set, cull, stats) {
+                    limit[i] = hit_limit(tile, set) * f.t_scale[i];
+                }
+            }
+            (V::from_slice(&limit), 0)
+        });
+    }
+
+    /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` lists the packets
+    /// that frustum lane `i` bounds.
+    pub fn occluded_mft<V: Vf32>(
+        &self,
+        f: &Frustum4<V>,
+        tile: &PacketTile<V>,
+        sets: &[Vec<usize>; 4],
+        cull: bool,
+        blocked: &mut [V::Mask],
+        stats: &mut TraversalStats,
+    ) {
+        let mut done = 0u32;
+        self.traverse_mft(f, stats, |tree, ids, bounds, active, stats| {
+            for (i, set) in sets.iter().enumerate() {
+                if active >> i & 1 == 1 {
+                    leaf_occlude(tree, ids.clone(), bounds, tile, set, cull, blocked, stats);
+                    if set.iter().all(|&j| (tile.packets[j].valid & !blocked[j]).none()) {
+                        done |= 1 << i;
+                    }
+                }
+            }
+            (V::splat(f32::INFINITY), done)
+        });
+    }
+
+    /// Walks the leaves the four frustums overlap. `leaf(tree, ids, box, active_bits, stats)` returns each
+    /// lane's distance limit and the lanes that are finished.
+    fn traverse_mft<V: Vf32>(
+        &self,
+        f: &Frustum4<V>,
+        stats: &mut TraversalStats,
+        mut leaf: impl FnMut(&KdTree, std::ops::Range<usize>, &Aabb, u32, &mut TraversalStats) -> (V, u32),
+    ) {
+        if self.triangles().is_empty() || f.valid.none() {
+            return;
+        }
+        let lo_slack = V::splat(1.0 - SPLIT_SLACK);
+        let hi_slack = V::splat(1.0 + SPLIT_SLACK);
+        let nodes = self.nodes();
+        let zero = V::splat(0.0);
+        let mut stack =
+            [Entry { node: 0, near: zero, far: zero, active: V::Mask::from_bits(0), bounds: Aabb::EMPTY }; STACK];
+        let mut sp = 0usize;
+        let (mut node, mut near, mut far, mut bounds) = (0usize, f.t_min, f.t_max, self.bounds());
+        let mut active = f.valid;
+        let mut done = V::Mask::from_bits(0);
+        let (mut visited, mut leaves) = (0u64, 0u64);
+        'walk: loop {
+            let n = nodes[node];
+            visited += 1;
+            if !n.is_leaf() {
+                let (axis, split) = (n.axis(), n.split());
+                let (lo, hi) = f.crossing(axis, split);
+                let origin_right = split - f.origin[axis] < 0.0;
+                let front = n.left() | origin_right as usize;
+                let (left_box, right_box) = child_boxes(&bounds, axis, split);
+                let (front_box, back_box) = if origin_right { (right_box, left_box) } else { (left_box, right_box) };
+                // Per frustum: all its rays cross before its interval (back only) or after it (front only).
+                let back_only = hi.lt(near * lo_slack);
+                let front_only = lo.gt(far * hi_slack);
+                let f_active = active & !back_only;
+                let b_active = active & !front_only;
+                let (f_far, b_near) = (hi.min(far), lo.max(near));
+                if f_active.none() {
+                    (node, near, active, bounds) = (front ^ 1, b_near, b_active, back_box);
+                    continue;
+                }
+                if b_active.any() {
+                    stack[sp] =
+                        Entry { node: (front ^ 1) as u32, near: b_near, far, active: b_active, bounds: back_box };
+                    sp += 1;
+                }
+                (node, far, active, bounds) = (front, f_far, f_active, front_box);
+                continue;
+            }
+            leaves += 1;
+            let (limit, finished) = leaf(self, n.leaf_range(), &bounds, (active & !done).bits(), stats);
+            done = done | V::Mask::from_bits(finished);
+            if (f.valid & !done).none() {
+                break;
+            }
+            loop {
+                if sp == 0 {
+                    break 'walk;
+                }
+                sp -= 1;
+                let e = stack[sp];
+                let a = e.active & !done & (e.near * lo_slack).le(limit);
+                if a.any() {
+                    (node, near, far, active, bounds) = (e.node as usize, e.near, e.far, a, e.bounds);
+                    break;
+                }
+            }
+        }
+        stats.nodes += visited;
+        stats.leaves += leaves;
+    }
+}

@@ -1,0 +1,200 @@
+//! Omni-directional packet traversal (Tsakok 2008, 4.1.2, Listing 4.1): the rays of a packet descend the
+//! tree together, one SIMD lane each, with no restriction on direction signs and no packet splitting.
+//!
+//! The thesis's two changes to classic packet traversal are kept: the child on the origin's side of the
+//! split is visited first, and negative plane distances count as infinite (the plane is behind the ray).
+//! Lanes whose origins lie on different sides of a split get their own intervals for both children, so
+//! packets of secondary rays with different origins stay exact. Each lane keeps an interval `[t_near,
+//! t_far]`; a child is entered when any lane's interval in it is non-empty, and a popped cell is skipped
+//! when every lane's part of it starts beyond that lane's closest hit.
+
+use raylab_simd::{VMask, Vf32};
+
+use super::mono::SPLIT_SLACK;
+use super::{KdParams, KdTree};
+use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
+use crate::stats::TraversalStats;
+
+#[derive(Clone, Copy)]
+struct Entry<V: Vf32> {
+    node: u32,
+    t_near: V,
+    t_far: V,
+}
+
+const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
+
+/// A fixed-size traversal stack (no allocation per packet); each inner node pushes at most one entry, so the
+/// depth limit bounds it.
+struct Stack<V: Vf32> {
+    entries: [Entry<V>; STACK],
+    len: usize,
+}
+
+/// Per-lane entry and exit distances of the packet's rays in the root box; a lane with a zero direction
+/// component is constrained by that slab only through its origin.
+fn clip_root<V: Vf32>(tree: &KdTree, p: &RayPacket<V>) -> (V, V) {
+    let b = tree.bounds();
+    let mut t_near = p.tmin;
+    let mut t_far = p.tmax;
+    let inf = V::splat(f32::INFINITY);
+    for k in 0..3 {
+        let (lo, hi) = (V::splat(b.min[k]), V::splat(b.max[k]));
+        let parallel = p.inv[k].abs().eq(inf);
+        let outside = p.org[k].lt(lo) | p.org[k].gt(hi);
+        let ta = (lo - p.org[k]) * p.inv[k];
+        let tb = (hi - p.org[k]) * p.inv[k];
+        let enter = V::select(parallel, V::select(outside, inf, V::splat(f32::NEG_INFINITY)), ta.min(tb));
+        let exit = V::select(parallel, V::select(outside, V::splat(f32::NEG_INFINITY), inf), ta.max(tb));
+        t_near = t_near.max(enter);
+        t_far = t_far.min(exit);
+    }
+    (t_near, t_far)
+}
+
+/// Lanes whose interval is non-empty, allowing the same slack as single-ray traversal.
+#[inline(always)]
+fn nonempty<V: Vf32>(t_near: V, t_far: V) -> V::Mask {
+    (t_near * V::splat(1.0 - SPLIT_SLACK)).le(t_far * V::splat(1.0 + SPLIT_SLACK))
+}
+
+impl KdTree {
+    /// Closest hits of a packet's rays, written to `hits` (whose `t` may start below the rays' `tmax` to
+    /// search only closer hits). Counts nodes, leaves and tests; the caller counts rays and packets.
+    pub fn intersect_packet<V: Vf32>(&self, p: &RayPacket<V>, hits: &mut PacketHits<V>, stats: &mut TraversalStats) {
+        let mut tests = 0u64;
+        self.traverse_packet(p, stats, |ids, active| {
+            for &id in &self.tri_ids()[ids] {
+                tests += 1;
+                intersect_packet(p, hits, self.triangles().get(id), id, active);
+            }
+            (hits.t, V::Mask::from_bits(0))
+        });
+        stats.isect_tests += tests;
+    }
+
+    /// The lanes whose rays are blocked within `(tmin, tmax]`.
+    pub fn occluded_packet<V: Vf32>(&self, p: &RayPacket<V>, stats: &mut TraversalStats) -> V::Mask {
+        let mut blocked = V::Mask::from_bits(0);
+        let mut tests = 0u64;
+        self.traverse_packet(p, stats, |ids, active| {
+            let mut open = active & !blocked;
+            for &id in &self.tri_ids()[ids] {
+                if open.none() {
+                    break;
+                }
+                tests += 1;
+                blocked = blocked | occlude_packet(p, self.triangles().get(id), open);
+                open = open & !blocked;
+            }
+            (p.tmax, blocked)
+        });
+        stats.isect_tests += tests;
+        blocked
+    }
+
+    /// Walks the leaves the packet's rays cross. `leaf(ids, active)` tests a leaf for the `active` lanes and
+    /// returns each lane's current limit (its closest hit, or `tmax`) and the lanes that are finished.
+    #[inline(always)]
+    fn traverse_packet<V: Vf32>(
+        &self,
+        p: &RayPacket<V>,
+        stats: &mut TraversalStats,
+        mut leaf: impl FnMut(std::ops::Range<usize>, V::Mask) -> (V, V::Mask),
+    ) {
+        if self.triangles().is_empty() || p.valid.none() {
+            return;
+        }
+        let (mut t_near, mut t_far) = clip_root(self, p);
+        let mut active = p.valid & nonempty(t_near, t_far);
+        if active.none() {
+            return;
+        }
+        let nodes = self.nodes();
+        let zero = V::splat(0.0);
+        let inf = V::splat(f32::INFINITY);
+        let mut stack = Stack { entries: [Entry { node: 0, t_near: zero, t_far: zero }; STACK], len: 0 };
+        let mut node = 0usize;
+        let (mut visited, mut leaves) = (0u64, 0u64);
+        let mut done = V::Mask::from_bits(0);
+        'walk: loop {
+            let n = nodes[node];
+            visited += 1;
+            if !n.is_leaf() {
+                let axis = n.axis();
+                let dist = V::splat(n.split()) - p.org[axis];
+                let d = dist * p.inv[axis];
+                // Listing 4.1, modification 1: a plane behind the ray is never reached.
+                let d = V::select(d.lt(zero), inf, d);
+                // Modification 2: the front child is on the origin's side; the first active lane decides
+                // for the packet, and lanes with origins on the other side swap their two intervals.
+                // An origin on the plane belongs to the side its ray leaves (crossing at t = 0 into the other).
+                let origin_right = dist.lt(zero) | (dist.eq(zero) & p.dir[axis].lt(zero));
+                let leader = active.bits().trailing_zeros();
+                let front_right = origin_right.bits() >> leader & 1 == 1;
+                let same = if front_right { origin_right } else { !origin_right };
+                let before = d.min(t_far);
+                let after = d.max(t_near);
+                let (f_near, f_far) = (V::select(same, t_near, after), V::select(same, before, t_far));
+                let (b_near, b_far) = (V::select(same, after, t_near), V::select(same, t_far, before));
+                let f_active = active & nonempty(f_near, f_far);
+                let b_active = active & nonempty(b_near, b_far);
+                let front = n.left() | front_right as usize;
+                let back = front ^ 1;
+                if f_active.none() {
+                    (node, t_near, t_far, active) = (back, b_near, b_far, b_active);
+                    if b_active.none() {
+                        match self.pop_packet(&mut stack, p, done, &mut t_near, &mut t_far, &mut active, inf) {
+                            Some(next) => node = next,
+                            None => break 'walk,
+                        }
+                    }
+                    continue;
+                }
+                if b_active.any() {
+                    stack.entries[stack.len] = Entry { node: back as u32, t_near: b_near, t_far: b_far };
+                    stack.len += 1;
+                }
+                (node, t_near, t_far, active) = (front, f_near, f_far, f_active);
+                continue;
+            }
+            leaves += 1;
+            let (limit, finished) = leaf(n.leaf_range(), active & !done);
+            done = done | finished;
+            if (p.valid & !done).none() {
+                break;
+            }
+            match self.pop_packet(&mut stack, p, done, &mut t_near, &mut t_far, &mut active, limit) {
+                Some(next) => node = next,
+                None => break,
+            }
+        }
+        stats.nodes += visited;
+        stats.leaves += leaves;
+    }
+
+    /// Pops the next stack entry in which some unfinished lane's interval starts no later than its limit.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn pop_packet<V: Vf32>(
+        &self,
+        stack: &mut Stack<V>,
+        p: &RayPacket<V>,
+        done: V::Mask,
+        t_near: &mut V,
+        t_far: &mut V,
+        active: &mut V::Mask,
+        limit: V,
+    ) -> Option<usize> {
+        while stack.len > 0 {
+            stack.len -= 1;
+            let e = stack.entries[stack.len];
+            let a = p.valid & !done & nonempty(e.t_near, e.t_far) & nonempty(e.t_near, limit);
+            if a.any() {
+                (*t_near, *t_far, *active) = (e.t_near, e.t_far, a);
+                return Some(e.node as usize);
+            }
+        }
+        None
+    }
+}

@@ -1,0 +1,126 @@
+//! Ray packets: a few rays in structure-of-arrays form, traced together with SIMD (Tsakok 2008, 2.3.1 and
+//! 4.1.2; Listings 2.5-2.6 show the SoA layout).
+
+mod tile;
+mod woop;
+
+use glam::Vec3;
+use raylab_simd::{VMask, Vf32};
+
+use crate::ray::{Hit, Ray};
+use crate::triangle::RayShear;
+
+pub use tile::{Frustum, PacketTile, overlaps_box};
+pub use woop::{intersect_packet, occlude_packet};
+
+/// Most lanes a packet may have (8 for AVX).
+pub const MAX_LANES: usize = 8;
+
+/// Up to [`Vf32::LANES`] rays in SoA form, with the per-lane constants of the watertight test.
+#[derive(Clone, Copy, Debug)]
+pub struct RayPacket<V: Vf32> {
+    /// Origins, one vector per axis.
+    pub org: [V; 3],
+    /// Directions.
+    pub dir: [V; 3],
+    /// Inverse directions.
+    pub inv: [V; 3],
+    /// Smallest accepted distances.
+    pub tmin: V,
+    /// Largest accepted distances.
+    pub tmax: V,
+    /// Lanes that hold a ray.
+    pub valid: V::Mask,
+    /// Per lane, masks for "axis index is 0" and "axis index is 1" of `kx`, `ky`, `kz` (Woop et al.).
+    pub(crate) axis_is: [[V::Mask; 2]; 3],
+    /// Per lane shear constants.
+    pub(crate) shear: [V; 3],
+    /// The rays themselves, for the exact scalar fallback of the watertight test.
+    pub(crate) rays: [Ray; MAX_LANES],
+}
+
+impl<V: Vf32> RayPacket<V> {
+    /// Packs `rays` (at most `V::LANES`; `None` leaves a lane empty). Invalid rays (NaN, zero direction) leave
+    /// their lane empty too.
+    pub fn new(rays: &[Option<Ray>]) -> Self {
+        assert!(rays.len() <= V::LANES && V::LANES <= MAX_LANES);
+        let filler = Ray::new(Vec3::ZERO, Vec3::Z);
+        let mut lanes = [filler; MAX_LANES];
+        let mut valid = 0u32;
+        for (i, r) in rays.iter().enumerate() {
+            if let Some(r) = r.filter(|r| r.is_valid()) {
+                lanes[i] = r;
+                valid |= 1 << i;
+            }
+        }
+        let gather = |f: &dyn Fn(&Ray) -> f32| {
+            let mut a = [0.0f32; MAX_LANES];
+            for (x, r) in a.iter_mut().zip(&lanes) {
+                *x = f(r);
+            }
+            V::from_slice(&a[..V::LANES])
+        };
+        let shears: Vec<RayShear> = lanes[..V::LANES].iter().map(RayShear::new).collect();
+        let axis_is = [0usize, 1, 2].map(|j| {
+            let bits = |want: usize| {
+                shears.iter().enumerate().fold(0u32, |m, (i, s)| m | (((s.axes()[j] == want) as u32) << i))
+            };
+            [V::Mask::from_bits(bits(0)), V::Mask::from_bits(bits(1))]
+        });
+        let shear_v = [0usize, 1, 2].map(|j| {
+            let mut a = [0.0f32; MAX_LANES];
+            for (x, s) in a.iter_mut().zip(&shears) {
+                *x = s.shear()[j];
+            }
+            V::from_slice(&a[..V::LANES])
+        });
+        Self {
+            org: [gather(&|r| r.origin.x), gather(&|r| r.origin.y), gather(&|r| r.origin.z)],
+            dir: [gather(&|r| r.dir.x), gather(&|r| r.dir.y), gather(&|r| r.dir.z)],
+            inv: [gather(&|r| 1.0 / r.dir.x), gather(&|r| 1.0 / r.dir.y), gather(&|r| 1.0 / r.dir.z)],
+            tmin: gather(&|r| r.tmin),
+            tmax: gather(&|r| r.tmax),
+            valid: V::Mask::from_bits(valid),
+            axis_is,
+            shear: shear_v,
+            rays: lanes,
+        }
+    }
+
+    /// The ray in lane `i`.
+    pub fn ray(&self, i: usize) -> &Ray {
+        &self.rays[i]
+    }
+}
+
+/// Closest hits of a packet, per lane.
+#[derive(Clone, Copy, Debug)]
+pub struct PacketHits<V: Vf32> {
+    /// Hit distance, or the ray's `tmax` where nothing was hit yet.
+    pub t: V,
+    /// Barycentric weight of vertex 1.
+    pub u: V,
+    /// Barycentric weight of vertex 2.
+    pub v: V,
+    /// Triangle id per lane (`u32::MAX` where nothing was hit).
+    pub tri: [u32; MAX_LANES],
+    /// Lanes that hit something.
+    pub hit: V::Mask,
+}
+
+impl<V: Vf32> PacketHits<V> {
+    /// No hits yet: `t` starts at each ray's `tmax`.
+    pub fn new(p: &RayPacket<V>) -> Self {
+        Self { t: p.tmax, u: V::splat(0.0), v: V::splat(0.0), tri: [u32::MAX; MAX_LANES], hit: V::Mask::from_bits(0) }
+    }
+
+    /// The hit of lane `i`.
+    pub fn get(&self, i: usize) -> Option<Hit> {
+        (self.hit.bits() >> i & 1 == 1).then(|| Hit {
+            t: self.t.lane(i),
+            tri: self.tri[i],
+            u: self.u.lane(i),
+            v: self.v.lane(i),
+        })
+    }
+}

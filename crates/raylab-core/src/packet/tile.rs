@@ -1,0 +1,227 @@
+//! A tile of rays cut into 2x2 packets, the unit that frustum kernels trace and cull (thesis 4.1.3-4.1.5).
+
+use glam::Vec3;
+use raylab_simd::{VMask, Vf32};
+
+use super::{PacketHits, RayPacket};
+use crate::aabb::Aabb;
+use crate::ray::Ray;
+
+/// The packets of a `width x height` tile in row-major pixel order, each 2 pixels wide and `V::LANES / 2`
+/// high; lane `i` holds pixel `(2 bx + i % 2, h by + i / 2)`. Pixels outside the tile leave lanes empty.
+pub struct PacketTile<V: Vf32> {
+    /// The packets.
+    pub packets: Vec<RayPacket<V>>,
+    /// Closest hits (or, for occlusion, the per-lane state) of each packet.
+    pub hits: Vec<PacketHits<V>>,
+    /// Index of each packet's lane-0 pixel in the tile, and the tile width, to map lanes back to pixels.
+    pub origin_pixel: Vec<(usize, usize)>,
+    /// Packet columns and rows.
+    pub cols: usize,
+    /// Packet rows.
+    pub rows: usize,
+    /// Tile width in pixels.
+    pub width: usize,
+    /// Tile height in pixels.
+    pub height: usize,
+}
+
+impl<V: Vf32> PacketTile<V> {
+    /// Packet height in pixels.
+    pub const PACKET_H: usize = V::LANES / 2;
+
+    /// Cuts `rays` (row-major, `width x height`) into packets.
+    pub fn new(rays: &[Option<Ray>], width: usize, height: usize) -> Self {
+        let ph = Self::PACKET_H;
+        let (cols, rows) = (width.div_ceil(2), height.div_ceil(ph));
+        let mut packets = Vec::with_capacity(cols * rows);
+        let mut origin_pixel = Vec::with_capacity(cols * rows);
+        let mut lane_rays = [None; super::MAX_LANES];
+        for by in 0..rows {
+            for bx in 0..cols {
+                for (i, slot) in lane_rays.iter_mut().enumerate().take(V::LANES) {
+                    let (x, y) = (2 * bx + i % 2, ph * by + i / 2);
+                    *slot = if x < width && y < height { rays[y * width + x] } else { None };
+                }
+                packets.push(RayPacket::new(&lane_rays[..V::LANES]));
+                origin_pixel.push((2 * bx, ph * by));
+            }
+        }
+        let hits = packets.iter().map(PacketHits::new).collect();
+        Self { packets, hits, origin_pixel, cols, rows, width, height }
+    }
+
+    /// Calls `f(pixel_index, lane)` for every lane of packet `j` that holds a ray.
+    pub fn for_each_lane(&self, j: usize, mut f: impl FnMut(usize, usize)) {
+        let (x0, y0) = self.origin_pixel[j];
+        let bits = self.packets[j].valid.bits();
+        for i in (0..V::LANES).filter(|i| bits >> i & 1 == 1) {
+            f((y0 + i / 2) * self.width + x0 + i % 2, i);
+        }
+    }
+
+    /// Indices of the packets inside the pixel rectangle `[x0, x1) x [y0, y1)` (packet-aligned).
+    pub fn packets_in(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> Vec<usize> {
+        let ph = Self::PACKET_H;
+        let mut v = Vec::new();
+        for by in y0 / ph..y1.div_ceil(ph).min(self.rows) {
+            for bx in x0 / 2..x1.div_ceil(2).min(self.cols) {
+                v.push(by * self.cols + bx);
+            }
+        }
+        v
+    }
+}
+
+/// The lanes of `p` whose ray overlaps box `b` within `(tmin, limit]` (the packet/leaf culling test of
+/// thesis 4.1.4), with the slab test's handling of zero direction components.
+#[inline(always)]
+pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -> V::Mask {
+    let inf = V::splat(f32::INFINITY);
+    let mut t0 = p.tmin;
+    let mut t1 = limit;
+    for k in 0..3 {
+        let (lo, hi) = (V::splat(b.min[k]), V::splat(b.max[k]));
+        let parallel = p.inv[k].abs().eq(inf);
+        let outside = p.org[k].lt(lo) | p.org[k].gt(hi);
+        let ta = (lo - p.org[k]) * p.inv[k];
+        let tb = (hi - p.org[k]) * p.inv[k];
+        let enter = V::select(parallel, V::select(outside, inf, V::splat(f32::NEG_INFINITY)), ta.min(tb));
+        let exit = V::select(parallel, V::select(outside, V::splat(f32::NEG_INFINITY), inf), ta.max(tb));
+        t0 = t0.max(enter);
+        t1 = t1.min(exit);
+    }
+    p.valid & (t0 * V::splat(1.0 - slack)).le(t1 * V::splat(1.0 + slack))
+}
+
+/// Bounds, for every axis, of the distances at which the rays of a bundle from one common origin cross an
+/// axis-aligned plane: the interval form of a frustum (thesis 2.3.2 and Listing 4.2, with the omni-directional
+/// changes of 4.1.2). Distances are measured along unit directions from `origin`.
+///
+/// For a plane at signed distance `dist = split - origin[k]`, a ray with unit direction `u` crosses it at
+/// `dist / u_k` when that is positive, and never otherwise. With `dist > 0` only rays with `1/u_k > 0` cross,
+/// at `dist * [min, max]` of those inverses, and any ray going the other way makes the far bound infinite;
+/// `dist < 0` mirrors this with the negative inverses. So four precomputed factors per axis give both bounds
+/// with one multiply each, for any mix of direction signs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frustum {
+    /// The common origin.
+    pub origin: Vec3,
+    /// `dist > 0`: near factor (smallest positive inverse, or +inf when no ray goes that way).
+    pub pos_near: [f32; 3],
+    /// `dist > 0`: far factor (largest positive inverse; +inf when some ray goes the other way).
+    pub pos_far: [f32; 3],
+    /// `dist < 0`: near factor (negative inverse closest to zero, or -inf when none).
+    pub neg_near: [f32; 3],
+    /// `dist < 0`: far factor (most negative inverse; -inf when some ray goes the other way).
+    pub neg_far: [f32; 3],
+    /// Smallest start distance of the rays.
+    pub t_min: f32,
+    /// Largest end distance of the rays.
+    pub t_max: f32,
+    /// Factor that turns a ray's own hit distance into a distance along a unit direction: the largest
+    /// direction length in the bundle (1 for unit directions), so that hit limits stay conservative.
+    pub t_scale: f32,
+    /// Distance by which the bundle's segments may miss `origin` (0 for rays that start there). Shadow rays
+    /// traced from the light end at `p + d * t_max`, which rounding puts a little off the light; planes
+    /// closer than this to the origin are crossed in both directions, and crossing bounds widen by it.
+    pub origin_slack: f32,
+}
+
+impl Frustum {
+    /// The frustum of segments `(unit direction, start, end)` from `origin`, distances along the unit
+    /// directions; `None` for an empty bundle. Set [`Frustum::t_scale`] when the rays' own directions are
+    /// not unit vectors.
+    pub fn bounding(origin: Vec3, segments: impl IntoIterator<Item = (Vec3, f32, f32)>) -> Option<Self> {
+        let mut f = Frustum {
+            origin,
+            pos_near: [f32::INFINITY; 3],
+            pos_far: [f32::NEG_INFINITY; 3],
+            neg_near: [f32::NEG_INFINITY; 3],
+            neg_far: [f32::INFINITY; 3],
+            t_min: f32::INFINITY,
+            t_max: f32::NEG_INFINITY,
+            t_scale: 1.0,
+            origin_slack: 0.0,
+        };
+        let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
+        let mut any = false;
+        for (dir, t0, t1) in segments {
+            any = true;
+            f.t_min = f.t_min.min(t0);
+            f.t_max = f.t_max.max(t1);
+            for k in 0..3 {
+                let inv = 1.0 / dir[k];
+                if inv > 0.0 {
+                    any_pos[k] = true;
+                    f.pos_near[k] = f.pos_near[k].min(inv);
+                    f.pos_far[k] = f.pos_far[k].max(inv);
+                } else {
+                    any_neg[k] = true;
+                    f.neg_near[k] = f.neg_near[k].max(inv);
+                    f.neg_far[k] = f.neg_far[k].min(inv);
+                }
+            }
+        }
+        if !any {
+            return None;
+        }
+        for k in 0..3 {
+            if any_neg[k] || !any_pos[k] {
+                f.pos_far[k] = f32::INFINITY;
+            }
+            if any_pos[k] || !any_neg[k] {
+                f.neg_far[k] = f32::NEG_INFINITY;
+            }
+        }
+        f.t_min = f.t_min.max(0.0);
+        Some(f)
+    }
+
+    /// The range of distances at which the bundle crosses the plane `coordinate k = split`; infinite bounds
+    /// mean "some ray never crosses in front of the origin".
+    #[inline(always)]
+    pub fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
+        let dist = split - self.origin[k];
+        let slack = self.origin_slack;
+        if dist > slack {
+            ((dist - slack) * self.pos_near[k], (dist + slack) * self.pos_far[k])
+        } else if dist < -slack {
+            ((dist + slack) * self.neg_near[k], (dist - slack) * self.neg_far[k])
+        } else {
+            (0.0, f32::INFINITY)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crossing_bounds_every_ray() {
+        let o = Vec3::new(0.5, -1.0, 2.0);
+        let dirs =
+            [Vec3::new(1.0, 0.2, -0.1), Vec3::new(0.8, -0.3, 0.4), Vec3::new(0.9, 0.0, 0.0), Vec3::new(1.0, 0.5, -0.5)]
+                .map(|d| d.normalize());
+        let f = Frustum::bounding(o, dirs.iter().map(|&d| (d, 0.0, 10.0))).unwrap();
+        for k in 0..3 {
+            for split in [-3.0f32, -0.7, 0.1, 0.5, 2.0, 4.0] {
+                let (lo, hi) = f.crossing(k, split);
+                assert!(lo <= hi, "axis {k} split {split}");
+                for d in dirs {
+                    let t = (split - o[k]) / d[k];
+                    if t > 0.0 && t.is_finite() {
+                        assert!(
+                            t >= lo * (1.0 - 1e-6) && t <= hi * (1.0 + 1e-6),
+                            "axis {k} split {split}: {t} not in [{lo}, {hi}]"
+                        );
+                    }
+                }
+            }
+        }
+        // Mixed signs on y: the far bound becomes infinite on both sides of the origin.
+        assert_eq!(f.crossing(1, 0.0).1, f32::INFINITY);
+        assert_eq!(f.crossing(1, 5.0).1, f32::INFINITY);
+    }
+}

@@ -1,0 +1,156 @@
+//! The watertight ray/triangle test (Woop, Benthin, Wald 2013) for a packet of rays against one triangle.
+//!
+//! Every lane performs exactly the `f32` operations of [`crate::triangle::RayShear::intersect`], in the
+//! same order: each lane's axis permutation is applied with selects instead of indexing, and lanes whose
+//! edge functions hit exactly zero are redone by the scalar test (its double-precision fallback). So a
+//! packet lane reports bit-for-bit what single-ray tracing reports for the same ray and triangle.
+
+use glam::Vec3;
+use raylab_simd::{VMask, Vf32};
+
+use super::{PacketHits, RayPacket};
+
+/// Picks component `axis` of `(x, y, z)` per lane, given the lane masks "axis is 0" and "axis is 1".
+#[inline(always)]
+fn pick<V: Vf32>(is: [V::Mask; 2], x: V, y: V, z: V) -> V {
+    V::select(is[0], x, V::select(is[1], y, z))
+}
+
+/// Result of testing one triangle: lanes hit and their distances and barycentrics.
+struct LaneHits<V: Vf32> {
+    mask: V::Mask,
+    t: V,
+    u: V,
+    v: V,
+}
+
+#[inline(always)]
+fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
+    let rel = |v: Vec3| [V::splat(v.x) - p.org[0], V::splat(v.y) - p.org[1], V::splat(v.z) - p.org[2]];
+    let (a, b, c) = (rel(tri[0]), rel(tri[1]), rel(tri[2]));
+    let [kx, ky, kz] = p.axis_is;
+    let [sx, sy, sz] = p.shear;
+    let permute =
+        |q: [V; 3]| (pick::<V>(kx, q[0], q[1], q[2]), pick::<V>(ky, q[0], q[1], q[2]), pick::<V>(kz, q[0], q[1], q[2]));
+    let (a_x, a_y, a_z) = permute(a);
+    let (b_x, b_y, b_z) = permute(b);
+    let (c_x, c_y, c_z) = permute(c);
+    let ax = a_x - sx * a_z;
+    let ay = a_y - sy * a_z;
+    let bx = b_x - sx * b_z;
+    let by = b_y - sy * b_z;
+    let cx = c_x - sx * c_z;
+    let cy = c_y - sy * c_z;
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    let zero = V::splat(0.0);
+    let exact_zero = (u.eq(zero) | v.eq(zero) | w.eq(zero)) & active;
+    let neg = u.lt(zero) | v.lt(zero) | w.lt(zero);
+    let pos = u.gt(zero) | v.gt(zero) | w.gt(zero);
+    let det = u + v + w;
+    let az = sz * a_z;
+    let bz = sz * b_z;
+    let cz = sz * c_z;
+    let t_scaled = u * az + v * bz + w * cz;
+    let det_neg = det.lt(zero);
+    let abs_det = det.abs();
+    let t_signed = V::select(det_neg, zero - t_scaled, t_scaled);
+    let inside = t_signed.gt(p.tmin * abs_det) & t_signed.le(tmax * abs_det);
+    let inv = V::splat(1.0) / det;
+    let t = t_scaled * inv;
+    let in_range = t.gt(p.tmin) & t.le(tmax);
+    let mut mask = active & !exact_zero & !(neg & pos) & !det.eq(zero) & inside & in_range;
+    let (mut t, mut bu, mut bv) = (t, v * inv, w * inv);
+    if exact_zero.any() {
+        // Rare: an edge function is exactly zero, and the paper recomputes it in double precision. Let the
+        // scalar test, which does exactly that, decide those lanes.
+        let bits = exact_zero.bits();
+        let (mut ta, mut ua, mut va) =
+            ([0.0f32; super::MAX_LANES], [0.0f32; super::MAX_LANES], [0.0f32; super::MAX_LANES]);
+        t.write_to(&mut ta[..V::LANES]);
+        bu.write_to(&mut ua[..V::LANES]);
+        bv.write_to(&mut va[..V::LANES]);
+        let mut hit_bits = mask.bits();
+        for i in (0..V::LANES).filter(|i| bits >> i & 1 == 1) {
+            let ray = p.ray(i);
+            if let Some(h) = crate::triangle::RayShear::new(ray).intersect(tri, ray.tmin, tmax.lane(i)) {
+                (ta[i], ua[i], va[i]) = (h.t, h.u, h.v);
+                hit_bits |= 1 << i;
+            }
+        }
+        mask = V::Mask::from_bits(hit_bits);
+        t = V::from_slice(&ta[..V::LANES]);
+        bu = V::from_slice(&ua[..V::LANES]);
+        bv = V::from_slice(&va[..V::LANES]);
+    }
+    LaneHits { mask, t, u: bu, v: bv }
+}
+
+/// Tests triangle `id` (corners `tri`) against the `active` lanes and keeps closer hits in `hits`, accepting
+/// `tmin < t <= hits.t` per lane as the scalar test does. Returns the lanes that hit it.
+#[inline(always)]
+pub fn intersect_packet<V: Vf32>(
+    p: &RayPacket<V>,
+    hits: &mut PacketHits<V>,
+    tri: &[Vec3; 3],
+    id: u32,
+    active: V::Mask,
+) -> V::Mask {
+    let r = test(p, tri, active, hits.t);
+    if r.mask.any() {
+        hits.t = V::select(r.mask, r.t, hits.t);
+        hits.u = V::select(r.mask, r.u, hits.u);
+        hits.v = V::select(r.mask, r.v, hits.v);
+        hits.hit = hits.hit | r.mask;
+        let bits = r.mask.bits();
+        for (i, slot) in hits.tri.iter_mut().enumerate().take(V::LANES) {
+            if bits >> i & 1 == 1 {
+                *slot = id;
+            }
+        }
+    }
+    r.mask
+}
+
+/// The `active` lanes that triangle `tri` blocks within `(tmin, tmax]`.
+#[inline(always)]
+pub fn occlude_packet<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask) -> V::Mask {
+    test(p, tri, active, p.tmax).mask
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ray::Ray;
+    use crate::triangle::RayShear;
+
+    fn lanes<V: Vf32>() {
+        let tri = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+        // Mixed directions and origins, an edge hit (exact zero edge function) and an axis-parallel miss.
+        let rays = [
+            Some(Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0))),
+            Some(Ray::new(Vec3::new(0.5, 0.0, -2.0), Vec3::new(0.0, 0.0, 1.0))),
+            Some(Ray::new(Vec3::new(-1.0, 0.3, 0.5), Vec3::new(1.2, 0.0, -0.4))),
+            Some(Ray::new(Vec3::new(0.2, 0.2, 0.0), Vec3::X)),
+        ];
+        let p = RayPacket::<V>::new(&rays);
+        let mut hits = PacketHits::new(&p);
+        intersect_packet(&p, &mut hits, &tri, 7, p.valid);
+        for (i, r) in rays.iter().enumerate() {
+            let r = r.unwrap();
+            let want = RayShear::new(&r).intersect(&tri, r.tmin, r.tmax);
+            let got = hits.get(i);
+            assert_eq!(got.map(|h| (h.t, h.u, h.v)), want.map(|h| (h.t, h.u, h.v)), "lane {i}");
+            assert_eq!(got.map(|h| h.tri), want.map(|_| 7));
+        }
+        assert_eq!(occlude_packet(&p, &tri, p.valid).bits(), hits.hit.bits());
+    }
+
+    #[test]
+    fn packet_lanes_equal_the_scalar_test() {
+        lanes::<raylab_simd::scalar::F32x4>();
+        #[cfg(target_arch = "x86_64")]
+        lanes::<raylab_simd::sse::F32x4>();
+    }
+}

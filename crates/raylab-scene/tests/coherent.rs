@@ -1,0 +1,144 @@
+//! Every coherent method (packets, frustums, MFT), tile size, SIMD backend and culling setting returns the
+//! same closest hit (triangle and t) and the same shadow occlusion as single-ray traversal for every pixel,
+//! on every built-in scene and on adversarial cameras.
+
+use glam::Vec3;
+use raylab_core::kdtree::{KdParams, KdTree};
+use raylab_core::method::Method;
+use raylab_core::ray::{Hit, Ray};
+use raylab_core::reference::BruteForce;
+use raylab_core::scene::{Camera, Scene};
+use raylab_core::stats::TraversalStats;
+use raylab_core::trace::{TraceOptions, Tracer};
+use raylab_core::workload::{RayKind, WorkloadBuilder};
+use raylab_scene::builtin::{self, Detail};
+use raylab_simd::Backend;
+
+const METHODS: [Method; 3] = [Method::Packet, Method::Frustum, Method::Mft];
+const TILES: [usize; 5] = [4, 8, 16, 32, 64];
+
+/// Traces `rays` (a `w x h` image) tile by tile with `tracer`.
+fn trace_image(
+    tracer: &Tracer,
+    rays: &[Option<Ray>],
+    w: usize,
+    h: usize,
+    tile: usize,
+    toward: Option<Vec3>,
+) -> (Vec<Option<Hit>>, Vec<bool>) {
+    let mut hits = vec![None; w * h];
+    let mut occ = vec![false; w * h];
+    let mut stats = TraversalStats::default();
+    for ty in (0..h).step_by(tile) {
+        for tx in (0..w).step_by(tile) {
+            let (tw, th) = (tile.min(w - tx), tile.min(h - ty));
+            let sub: Vec<Option<Ray>> =
+                (0..th).flat_map(|y| (0..tw).map(move |x| (x, y))).map(|(x, y)| rays[(ty + y) * w + tx + x]).collect();
+            let mut out_h = vec![None; tw * th];
+            let mut out_o = vec![false; tw * th];
+            tracer.intersect_tile(&sub, tw, th, &mut out_h, &mut stats);
+            tracer.occluded_tile(&sub, tw, th, toward, &mut out_o, &mut stats);
+            for y in 0..th {
+                for x in 0..tw {
+                    hits[(ty + y) * w + tx + x] = out_h[y * tw + x];
+                    occ[(ty + y) * w + tx + x] = out_o[y * tw + x];
+                }
+            }
+        }
+    }
+    (hits, occ)
+}
+
+fn same_hit(bf: &BruteForce, ray: &Ray, got: Option<Hit>, want: Option<Hit>) -> bool {
+    match (got, want) {
+        (None, None) => true,
+        (Some(g), Some(w)) => {
+            g.tri == w.tri && g.t == w.t || (g.t - w.t).abs() <= 1e-5 * w.t && bf.hit_distance(ray, g.tri) == Some(g.t)
+        }
+        _ => false,
+    }
+}
+
+/// Compares every method against mono on the primary and shadow rays of one view.
+fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what: &str) {
+    let tree = KdTree::build(scene, &KdParams::default()).unwrap();
+    let bf = BruteForce::new(scene);
+    let wb = WorkloadBuilder::new(scene, cam, light, w as u32, h as u32, &tree);
+    let primary = wb.build(RayKind::Primary).rays;
+    let shadow = wb.build(RayKind::Shadow).rays;
+    let mono = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
+    let (want_hits, _) = trace_image(&mono, &primary, w, h, 8, None);
+    let (_, want_occ) = trace_image(&mono, &shadow, w, h, 8, Some(light));
+    for method in METHODS {
+        for backend in Backend::available() {
+            for cull in [true, false] {
+                for tile in TILES {
+                    let opts = TraceOptions { method, cull, backend };
+                    let tracer = Tracer::new(&tree, None, opts);
+                    let (hits, _) = trace_image(&tracer, &primary, w, h, tile, None);
+                    let (_, occ) = trace_image(&tracer, &shadow, w, h, tile, Some(light));
+                    for i in 0..w * h {
+                        if let Some(r) = &primary[i] {
+                            assert!(
+                                same_hit(&bf, r, hits[i], want_hits[i]),
+                                "{what}: {opts:?} tile {tile} pixel {i}: {:?} vs mono {:?}",
+                                hits[i],
+                                want_hits[i]
+                            );
+                        }
+                        assert_eq!(occ[i], want_occ[i], "{what}: {opts:?} tile {tile} shadow pixel {i}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn coherent_methods_match_mono_on_every_builtin_scene() {
+    for name in builtin::names() {
+        let scene = builtin::build(name, Detail::Test).unwrap();
+        let cam = scene.default_view().unwrap().camera;
+        let light = scene.lights[0].position;
+        check_view(&scene, &cam, light, 45, 37, name);
+    }
+}
+
+#[test]
+fn coherent_methods_match_mono_on_adversarial_cameras() {
+    let scene = builtin::build("atrium", Detail::Test).unwrap();
+    let light = scene.lights[0].position;
+    let views = [
+        ("along +x", Camera::look_at(Vec3::new(-10.0, 2.0, 0.0), Vec3::new(10.0, 2.0, 0.0), Vec3::Y, 60.0), 40, 40),
+        ("down -y", Camera::look_at(Vec3::new(0.5, 11.0, 0.5), Vec3::new(0.5, 0.0, 0.5), Vec3::X, 90.0), 33, 33),
+        (
+            "inside a column",
+            Camera::look_at(Vec3::new(-3.0, 2.0, 4.0), Vec3::new(3.0, 2.5, -4.0), Vec3::Y, 70.0),
+            24,
+            17,
+        ),
+        ("fov 1", Camera::look_at(Vec3::new(-12.0, 2.5, 0.3), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 1.0), 20, 20),
+        ("fov 170", Camera::look_at(Vec3::new(0.0, 3.0, 0.0), Vec3::new(5.0, 3.0, 1.0), Vec3::Y, 170.0), 50, 30),
+        ("1x1", Camera::look_at(Vec3::new(-12.5, 2.5, 0.0), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 65.0), 1, 1),
+        ("1x1000", Camera::look_at(Vec3::new(-12.5, 2.5, 0.0), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 65.0), 1, 1000),
+        (
+            "on a split plane",
+            Camera::look_at(Vec3::new(0.0, 6.0, 4.0), Vec3::new(0.0, 6.0, -4.0), Vec3::Y, 80.0),
+            31,
+            29,
+        ),
+    ];
+    for (what, cam, w, h) in views {
+        check_view(&scene, &cam, light, w, h, what);
+    }
+}
+
+#[test]
+fn shadow_rays_from_a_light_on_a_split_plane() {
+    // The light sits exactly on split planes of the tree and on a triangle's plane.
+    let scene = builtin::build("arena", Detail::Test).unwrap();
+    let cam = scene.default_view().unwrap().camera;
+    for light in [Vec3::new(0.0, 4.8, 0.0), Vec3::new(8.0, 4.4, 0.0), Vec3::new(3.0, 14.0, 2.0)] {
+        check_view(&scene, &cam, light, 40, 32, &format!("light {light}"));
+    }
+}

@@ -1,0 +1,147 @@
+//! The SSE2 backend (part of every x86-64 CPU, so no run-time detection is needed for it).
+
+use std::arch::x86_64::*;
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Not, Sub};
+
+use crate::{VMask, Vf32};
+
+/// Evaluates an expression of register-only SSE/SSE2 intrinsics.
+macro_rules! sse {
+    ($e:expr) => {
+        // SAFETY: SSE and SSE2 are part of the x86-64 baseline: every x86-64 CPU has them and the compiler
+        // enables them by default, and these intrinsics only read and write registers.
+        unsafe { $e }
+    };
+}
+
+/// Four `f32` lanes in an SSE register.
+#[derive(Clone, Copy, Debug)]
+pub struct F32x4(__m128);
+
+/// Four lane masks (all bits set or clear per lane) in an SSE register.
+#[derive(Clone, Copy, Debug)]
+pub struct M32x4(__m128);
+
+impl VMask for M32x4 {
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        sse!(_mm_movemask_ps(self.0)) as u32
+    }
+    #[inline(always)]
+    fn from_bits(bits: u32) -> Self {
+        sse!({
+            let lane_bits = _mm_setr_epi32(1, 2, 4, 8);
+            let set = _mm_and_si128(_mm_set1_epi32(bits as i32), lane_bits);
+            Self(_mm_castsi128_ps(_mm_cmpeq_epi32(set, lane_bits)))
+        })
+    }
+}
+
+impl BitAnd for M32x4 {
+    type Output = Self;
+    #[inline(always)]
+    fn bitand(self, o: Self) -> Self {
+        Self(sse!(_mm_and_ps(self.0, o.0)))
+    }
+}
+
+impl BitOr for M32x4 {
+    type Output = Self;
+    #[inline(always)]
+    fn bitor(self, o: Self) -> Self {
+        Self(sse!(_mm_or_ps(self.0, o.0)))
+    }
+}
+
+impl BitXor for M32x4 {
+    type Output = Self;
+    #[inline(always)]
+    fn bitxor(self, o: Self) -> Self {
+        Self(sse!(_mm_xor_ps(self.0, o.0)))
+    }
+}
+
+impl Not for M32x4 {
+    type Output = Self;
+    #[inline(always)]
+    fn not(self) -> Self {
+        Self(sse!(_mm_xor_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(-1)))))
+    }
+}
+
+macro_rules! arith {
+    ($trait:ident, $f:ident, $intr:ident) => {
+        impl $trait for F32x4 {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(self, o: Self) -> Self {
+                Self(sse!($intr(self.0, o.0)))
+            }
+        }
+    };
+}
+
+arith!(Add, add, _mm_add_ps);
+arith!(Sub, sub, _mm_sub_ps);
+arith!(Mul, mul, _mm_mul_ps);
+arith!(Div, div, _mm_div_ps);
+
+impl Vf32 for F32x4 {
+    type Mask = M32x4;
+    const LANES: usize = 4;
+
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Self(sse!(_mm_set1_ps(x)))
+    }
+    #[inline(always)]
+    fn from_slice(s: &[f32]) -> Self {
+        assert!(s.len() >= 4);
+        // SAFETY: the assert guarantees four readable `f32`s; `loadu` has no alignment requirement.
+        Self(unsafe { _mm_loadu_ps(s.as_ptr()) })
+    }
+    #[inline(always)]
+    fn write_to(self, out: &mut [f32]) {
+        assert!(out.len() >= 4);
+        // SAFETY: the assert guarantees four writable `f32`s; `storeu` has no alignment requirement.
+        unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) }
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f32 {
+        let mut a = [0.0; 4];
+        self.write_to(&mut a);
+        a[i]
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> M32x4 {
+        M32x4(sse!(_mm_cmplt_ps(self.0, o.0)))
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> M32x4 {
+        M32x4(sse!(_mm_cmple_ps(self.0, o.0)))
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> M32x4 {
+        M32x4(sse!(_mm_cmpeq_ps(self.0, o.0)))
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        Self(sse!(_mm_min_ps(self.0, o.0)))
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        Self(sse!(_mm_max_ps(self.0, o.0)))
+    }
+    #[inline(always)]
+    fn select(m: M32x4, a: Self, b: Self) -> Self {
+        Self(sse!(_mm_or_ps(_mm_and_ps(m.0, a.0), _mm_andnot_ps(m.0, b.0))))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Self(sse!(_mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff)))))
+    }
+    #[inline(always)]
+    fn sign_mask(self) -> M32x4 {
+        M32x4(sse!(_mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(self.0), 31))))
+    }
+}
