@@ -23,6 +23,15 @@ pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::from_array(v))
 }
 
+/// Parses a SIMD backend name (`sse2` or `scalar`); refuses one this CPU cannot run.
+pub fn parse_backend(s: &str) -> Result<raylab_simd::Backend, String> {
+    let avail = raylab_simd::Backend::available();
+    avail.iter().copied().find(|b| b.name() == s).ok_or_else(|| {
+        let names: Vec<_> = avail.iter().map(|b| b.name()).collect();
+        format!("unknown or unavailable backend '{s}' (available here: {})", names.join(", "))
+    })
+}
+
 /// A clap value parser for integers in `lo..=hi`.
 pub fn in_range(lo: u64, hi: u64) -> impl Fn(&str) -> Result<u64, String> + Clone + Send + Sync + 'static {
     move |s: &str| {
@@ -149,5 +158,33 @@ impl KdArgs {
         };
         p.validate().map_err(|m| format!("--kd-*: {m}"))?;
         Ok(p)
+    }
+}
+
+/// Traversal-method flags shared by `render` and `trace`.
+#[derive(Args, Clone, Debug)]
+pub struct MethodArgs {
+    /// Traversal method: mono, packet, frustum, mft or reference.
+    #[arg(long, default_value = "mono")]
+    pub method: raylab_core::method::Method,
+    /// Tile edge in pixels: the frustum size of frustum methods, the unit threads take for all.
+    #[arg(long, default_value_t = 16, value_parser = in_range(1, 256))]
+    pub tile: u64,
+    /// Turn packet/leaf culling off (frustum methods).
+    #[arg(long)]
+    pub no_cull: bool,
+    /// SIMD backend of packet kernels: sse2 (x86-64) or scalar.
+    #[arg(long, value_parser = parse_backend)]
+    pub backend: Option<raylab_simd::Backend>,
+}
+
+impl MethodArgs {
+    /// The tracer options these flags select.
+    pub fn options(&self) -> raylab_core::trace::TraceOptions {
+        raylab_core::trace::TraceOptions {
+            method: self.method,
+            cull: !self.no_cull,
+            backend: self.backend.unwrap_or_else(raylab_simd::Backend::detect),
+        }
     }
 }

@@ -4,16 +4,16 @@
 
 use std::time::Instant;
 
-use raylab_core::method::Intersector;
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
 use raylab_core::stats::TraversalStats;
+use raylab_core::trace::Tracer;
 use raylab_core::workload::{RayKind, Workload};
 use rayon::prelude::*;
 use serde::Serialize;
 
 /// The tile edge the harness uses.
-pub const TILE: u32 = 16;
+pub const HARNESS_TILE: u32 = 16;
 
 /// Per-pixel result of a trace: hit distance (closest-hit kinds) or occlusion.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,53 +53,72 @@ pub struct TraceReport {
     pub leaves_per_ray: f64,
     /// Triangle tests per ray.
     pub isects_per_ray: f64,
+    /// The thesis's N: nodes per 2x2 packet (per ray for single-ray methods).
+    pub nodes_per_packet: f64,
+    /// The thesis's I: intersection tests per 2x2 packet (per ray for single-ray methods).
+    pub isects_per_packet: f64,
+    /// Share of packets culled at leaves, in percent of packet visits to non-empty leaves.
+    pub culled_percent: f64,
 }
 
-/// Traces every ray of `w` once, on the current rayon pool, tile by tile.
-pub fn trace_once(tracer: &dyn Intersector, w: &Workload) -> (Vec<PixelResult>, TraversalStats) {
-    let (width, height) = (w.width, w.height);
-    let tiles: Vec<(u32, u32)> = (0..height.div_ceil(TILE))
-        .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+/// Traces every ray of `w` once, on the current rayon pool, in `tile x tile` tiles taken by the threads.
+pub fn trace_once(tracer: &Tracer, w: &Workload, tile: u32) -> (Vec<PixelResult>, TraversalStats) {
+    let (width, height) = (w.width as usize, w.height as usize);
+    let tile = tile as usize;
+    let tiles: Vec<(usize, usize)> = (0..height.div_ceil(tile))
+        .flat_map(|ty| (0..width.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile)))
         .collect();
     let occlusion = w.kind.is_occlusion();
-    let parts: Vec<(Vec<(usize, PixelResult)>, TraversalStats)> = tiles
+    let parts: Vec<TileOutput> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             let mut stats = TraversalStats::default();
-            let mut out = Vec::with_capacity((TILE * TILE) as usize);
-            for y in y0..(y0 + TILE).min(height) {
-                for x in x0..(x0 + TILE).min(width) {
-                    let i = (y * width + x) as usize;
-                    let Some(ray) = &w.rays[i] else { continue };
-                    out.push((i, trace_ray(tracer, ray, occlusion, &mut stats)));
-                }
-            }
-            (out, stats)
+            let (tw, th) = (tile.min(width - x0), tile.min(height - y0));
+            let rays: Vec<Option<Ray>> = (y0..y0 + th)
+                .flat_map(|y| (x0..x0 + tw).map(move |x| (x, y)))
+                .map(|(x, y)| w.rays[y * width + x])
+                .collect();
+            let results = if occlusion {
+                let mut out = vec![false; rays.len()];
+                tracer.occluded_tile(&rays, tw, th, w.toward, &mut out, &mut stats);
+                rays.iter()
+                    .zip(out)
+                    .map(|(r, o)| if r.is_some() { PixelResult::Occluded(o) } else { PixelResult::None })
+                    .collect()
+            } else {
+                let mut out = vec![None; rays.len()];
+                tracer.intersect_tile(&rays, tw, th, &mut out, &mut stats);
+                rays.iter()
+                    .zip(out)
+                    .map(
+                        |(r, h)| {
+                            if r.is_some() { PixelResult::Hit(h.map(|h| (h.t, h.tri))) } else { PixelResult::None }
+                        },
+                    )
+                    .collect()
+            };
+            ((x0, y0, tw, th), results, stats)
         })
         .collect();
     let mut results = vec![PixelResult::None; w.rays.len()];
     let mut stats = TraversalStats::default();
-    for (part, s) in parts {
-        for (i, r) in part {
-            results[i] = r;
+    for ((x0, y0, tw, _), part, s) in parts {
+        for (i, r) in part.into_iter().enumerate() {
+            results[(y0 + i / tw) * width + x0 + i % tw] = r;
         }
         stats += s;
     }
     (results, stats)
 }
 
-fn trace_ray(tracer: &dyn Intersector, ray: &Ray, occlusion: bool, stats: &mut TraversalStats) -> PixelResult {
-    if occlusion {
-        PixelResult::Occluded(tracer.occluded(ray, stats))
-    } else {
-        PixelResult::Hit(tracer.intersect(ray, stats).map(|h| (h.t, h.tri)))
-    }
-}
+/// A traced tile: its rectangle, per-pixel results and counters.
+type TileOutput = ((usize, usize, usize, usize), Vec<PixelResult>, TraversalStats);
 
 /// Runs `warmup` untimed and `reps` timed traces of `w` on a pool of `threads` threads.
 pub fn measure(
-    tracer: &dyn Intersector,
+    tracer: &Tracer,
     w: &Workload,
+    tile: u32,
     threads: usize,
     warmup: usize,
     reps: usize,
@@ -113,11 +132,11 @@ pub fn measure(
     let mut speeds = Vec::with_capacity(reps);
     pool.install(|| {
         for _ in 0..warmup {
-            last = Some(trace_once(tracer, w));
+            last = Some(trace_once(tracer, w, tile));
         }
         for _ in 0..reps.max(1) {
             let t0 = Instant::now();
-            let r = trace_once(tracer, w);
+            let r = trace_once(tracer, w, tile);
             let secs = t0.elapsed().as_secs_f64();
             speeds.push(rays as f64 / secs.max(1e-12) / 1e6);
             last = Some(r);
@@ -139,8 +158,17 @@ pub fn measure(
         nodes_per_ray: stats.nodes_per_ray(),
         leaves_per_ray: stats.leaves_per_ray(),
         isects_per_ray: stats.isects_per_ray(),
+        nodes_per_packet: stats.nodes_per_packet(),
+        isects_per_packet: stats.isects_per_packet(),
+        culled_percent: culled_percent(&stats),
     };
     Ok((report, results))
+}
+
+/// Culled packet visits as a share of packet visits to leaves (culled plus tested), in percent.
+fn culled_percent(s: &TraversalStats) -> f64 {
+    let tested = s.packets_culled + s.packets_tested;
+    if tested == 0 { 0.0 } else { 100.0 * s.packets_culled as f64 / tested as f64 }
 }
 
 /// Hit (or occluded) count and the sum of hit distances.

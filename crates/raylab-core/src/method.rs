@@ -42,6 +42,11 @@ impl Method {
         }
     }
 
+    /// True for the methods that trace tiles as 2x2 packets (and so need rows of pixels).
+    pub fn uses_packets(self) -> bool {
+        matches!(self, Method::Packet | Method::Frustum | Method::Mft)
+    }
+
     /// True for the methods whose cost depends on the tile size (frustums).
     pub fn uses_tiles(self) -> bool {
         matches!(self, Method::Frustum | Method::Mft)

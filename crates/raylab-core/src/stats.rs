@@ -26,6 +26,8 @@ pub struct TraversalStats {
     pub packets: u64,
     /// Packets skipped at a leaf because none of their rays overlaps its box (thesis 4.1.4).
     pub packets_culled: u64,
+    /// Packet visits to non-empty leaves that went on to triangle tests (culled ones excluded).
+    pub packets_tested: u64,
 }
 
 impl AddAssign for TraversalStats {
@@ -36,6 +38,7 @@ impl AddAssign for TraversalStats {
         self.isect_tests += o.isect_tests;
         self.packets += o.packets;
         self.packets_culled += o.packets_culled;
+        self.packets_tested += o.packets_tested;
     }
 }
 
@@ -76,8 +79,24 @@ mod tests {
 
     #[test]
     fn merge_and_ratios() {
-        let mut a = TraversalStats { rays: 2, nodes: 10, leaves: 4, isect_tests: 6, packets: 2, packets_culled: 0 };
-        a += TraversalStats { rays: 2, nodes: 2, leaves: 0, isect_tests: 2, packets: 2, packets_culled: 1 };
+        let mut a = TraversalStats {
+            rays: 2,
+            nodes: 10,
+            leaves: 4,
+            isect_tests: 6,
+            packets: 2,
+            packets_culled: 0,
+            packets_tested: 0,
+        };
+        a += TraversalStats {
+            rays: 2,
+            nodes: 2,
+            leaves: 0,
+            isect_tests: 2,
+            packets: 2,
+            packets_culled: 1,
+            packets_tested: 3,
+        };
         assert_eq!(a.nodes_per_ray(), 3.0);
         assert_eq!(a.isects_per_ray(), 2.0);
         assert_eq!(TraversalStats::default().nodes_per_ray(), 0.0);

@@ -85,6 +85,9 @@ pub struct Workload {
     pub height: u32,
     /// One entry per pixel.
     pub rays: Vec<Option<Ray>>,
+    /// The point every ray ends at, when there is one (the light, for shadow rays): frustum methods trace
+    /// such rays from that point, as the thesis traces shadow rays from the light.
+    pub toward: Option<Vec3>,
 }
 
 impl Workload {
@@ -178,7 +181,8 @@ impl<'a> WorkloadBuilder<'a> {
                 (0..self.pass.rays.len()).map(|i| self.secondary(kind, i, eps)).collect()
             }
         };
-        Workload { kind, width: self.width, height: self.height, rays }
+        let toward = (kind == RayKind::Shadow).then_some(self.light);
+        Workload { kind, width: self.width, height: self.height, rays, toward }
     }
 
     fn secondary(&self, kind: RayKind, i: usize, eps: f32) -> Option<Ray> {

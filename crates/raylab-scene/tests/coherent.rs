@@ -142,3 +142,25 @@ fn shadow_rays_from_a_light_on_a_split_plane() {
         check_view(&scene, &cam, light, 40, 32, &format!("light {light}"));
     }
 }
+
+/// The renderer's pixels do not depend on the traversal method (primary hits and hard shadows).
+#[test]
+fn rendered_frames_are_identical_for_every_method() {
+    use raylab_core::render::{RenderSettings, render};
+    let scene = builtin::build("atrium", Detail::Test).unwrap();
+    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let cam = scene.default_view().unwrap().camera;
+    let light = scene.lights[0];
+    let mut frames = Vec::new();
+    for method in [Method::Mono, Method::Packet, Method::Frustum, Method::Mft] {
+        for tile in [4, 16] {
+            let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
+            let settings = RenderSettings { width: 61, height: 43, tile, ..Default::default() };
+            frames.push((method, tile, render(&scene, &tracer, &cam, light, &settings).rgba));
+        }
+    }
+    for (method, tile, f) in &frames[1..] {
+        let diff = f.iter().zip(&frames[0].2).filter(|(a, b)| a != b).count();
+        assert_eq!(diff, 0, "{method} tile {tile}: {diff} pixels differ from mono");
+    }
+}

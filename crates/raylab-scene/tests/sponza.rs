@@ -72,7 +72,8 @@ fn sponza_render_matches_embree_pixel_for_pixel() {
     let camera = Camera::look_at(Vec3::new(-12.5, 2.5, 0.0), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 65.0);
     let light = raylab_core::scene::PointLight::at(Vec3::new(0.0, 11.0, 0.0));
     let settings = raylab_core::render::RenderSettings { width: 1280, height: 720, ..Default::default() };
-    let frame = raylab_core::render::render(&scene, &tree, &camera, light, &settings);
+    let tracer = raylab_core::trace::Tracer::new(&tree, None, Default::default());
+    let frame = raylab_core::render::render(&scene, &tracer, &camera, light, &settings);
     assert_eq!((reference.width(), reference.height()), (1280, 720));
     let (mut off_by_one, mut different) = (0, 0);
     for (ours, theirs) in frame.rgba.iter().zip(reference.pixels()) {

@@ -7,13 +7,15 @@ use std::process::Command;
 
 use clap::Args;
 use raylab_core::kdtree::KdTree;
+use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
+use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 
 use crate::args::{KdArgs, SceneArgs, in_range};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene, with_spinner};
-use crate::timing::{TraceReport, measure, validate};
+use crate::timing::{HARNESS_TILE, TraceReport, measure, validate};
 
 /// Compares raylab's single-ray kd-tree with Embree's single-ray API on the harness's rays.
 #[derive(Args, Debug)]
@@ -139,7 +141,9 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     for kind in RayKind::ALL {
         let workload = wb.build(kind);
         for &t in &a.threads {
-            let (report, results) = measure(&tree, &workload, t as usize, a.warmup as usize, a.reps as usize)?;
+            let tracer = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
+            let (report, results) =
+                measure(&tracer, &workload, HARNESS_TILE, t as usize, a.warmup as usize, a.reps as usize)?;
             validate(&reference, &workload, &results, 256).map_err(|m| format!("validation failed: {m}"))?;
             ours.push(report);
         }

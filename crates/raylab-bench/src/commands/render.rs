@@ -4,9 +4,12 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
+use raylab_core::method::Method;
+use raylab_core::reference::BruteForce;
 use raylab_core::render::{RayOrder, RenderSettings, render};
+use raylab_core::trace::Tracer;
 
-use crate::args::{KdArgs, SceneArgs, in_range};
+use crate::args::{KdArgs, MethodArgs, SceneArgs, in_range};
 use crate::prepare::{build_tree, load_scene};
 
 /// Renders one frame to a PNG file.
@@ -25,9 +28,8 @@ pub struct RenderArgs {
     /// Output PNG file.
     #[arg(long, default_value = "raylab.png")]
     out: PathBuf,
-    /// Tile edge in pixels.
-    #[arg(long, default_value_t = 16, value_parser = in_range(1, 256))]
-    tile: u64,
+    #[command(flatten)]
+    m: MethodArgs,
     /// Pixel order inside a tile: scanline, morton or hilbert.
     #[arg(long, default_value = "scanline")]
     order: RayOrder,
@@ -61,25 +63,28 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
     let settings = RenderSettings {
         width: a.width as u32,
         height: a.height as u32,
-        tile: a.tile as u32,
+        tile: a.m.tile as u32,
         order: a.order,
         shadows: !a.no_shadows,
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     let t0 = Instant::now();
-    let frame = pool.install(|| render(&scene, &tree, &camera, light, &settings));
+    let reference = (a.m.method == Method::Reference).then(|| BruteForce::new(&scene));
+    let tracer = Tracer::new(&tree, reference.as_ref(), a.m.options());
+    let frame = pool.install(|| render(&scene, &tracer, &camera, light, &settings));
     let render_s = t0.elapsed().as_secs_f64();
     let rgba: Vec<u8> = frame.rgba.iter().flatten().copied().collect();
     let img = image::RgbaImage::from_raw(frame.width, frame.height, rgba).ok_or("frame buffer size mismatch")?;
     img.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
     println!(
-        "{}: {} triangles, loaded in {:.3} s, kd-tree in {:.3} s; rendered {}x{} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",
+        "{}: {} triangles, loaded in {:.3} s, kd-tree in {:.3} s; rendered {}x{} with {} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",
         a.scene.scene,
         scene.triangle_count(),
         load_s,
         tree.build_time().as_secs_f64(),
         frame.width,
         frame.height,
+        a.m.method,
         render_s,
         threads,
         frame.stats.rays as f64 / render_s / 1e6,

@@ -1,13 +1,12 @@
 //! `raylab-bench trace`: throughput of one method on the harness's rays.
 
 use clap::Args;
-use raylab_core::kdtree::KdTree;
-use raylab_core::method::{Intersector, Method};
 use raylab_core::reference::BruteForce;
+use raylab_core::trace::Tracer;
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 use serde_json::json;
 
-use crate::args::{KdArgs, SceneArgs, in_range};
+use crate::args::{KdArgs, MethodArgs, SceneArgs, in_range};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene, with_spinner};
 use crate::timing::{measure, validate};
@@ -28,9 +27,8 @@ pub struct TraceArgs {
     /// Ray kind: primary, shadow or diffuse.
     #[arg(long, default_value = "primary")]
     kind: RayKind,
-    /// Traversal method.
-    #[arg(long, default_value = "mono")]
-    method: Method,
+    #[command(flatten)]
+    m: MethodArgs,
     /// Tracing threads.
     #[arg(long, default_value_t = 1, value_parser = in_range(1, 1024))]
     threads: u64,
@@ -63,15 +61,14 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         WorkloadBuilder::new(&scene, &camera, light.position, w, h, &tree).seed(a.seed)
     });
     let workload = builder.build(a.kind);
-    let tracer: &dyn Intersector = match a.method {
-        Method::Mono => &tree as &KdTree,
-        Method::Reference => &reference,
-    };
-    let (report, results) = measure(tracer, &workload, a.threads as usize, a.warmup as usize, a.reps as usize)?;
+    let options = a.m.options();
+    let tracer = Tracer::new(&tree, Some(&reference), options);
+    let (report, results) =
+        measure(&tracer, &workload, a.m.tile as u32, a.threads as usize, a.warmup as usize, a.reps as usize)?;
     let checked = with_spinner("validating against brute force", || {
         validate(&reference, &workload, &results, a.validate as usize)
     })
-    .map_err(|m| format!("validation failed ({} vs brute force): {m}", a.method))?;
+    .map_err(|m| format!("validation failed ({} vs brute force): {m}", a.m.method))?;
     if a.json {
         let v = json!({
             "environment": env,
@@ -81,7 +78,10 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
             "light": light.position.to_array(),
             "width": w,
             "height": h,
-            "method": a.method,
+            "method": a.m.method,
+            "tile": a.m.tile,
+            "cull": options.cull,
+            "backend": options.backend.name(),
             "kd_build_seconds": tree.build_time().as_secs_f64(),
             "validated_rays": checked,
             "result": report,
@@ -95,8 +95,17 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     println!("validated        {checked} rays against brute force");
     let what = if a.kind.is_occlusion() { "occluded" } else { "hits" };
     println!(
-        "{} {} threads {}: rays {}, {} {}, sum_t {:.6}",
-        a.kind, a.method, report.threads, report.rays, what, report.hits, report.sum_t
+        "{} {} tile {} cull {} backend {} threads {}: rays {}, {} {}, sum_t {:.6}",
+        a.kind,
+        a.m.method,
+        a.m.tile,
+        options.cull,
+        options.backend.name(),
+        report.threads,
+        report.rays,
+        what,
+        report.hits,
+        report.sum_t
     );
     println!(
         "Mrays/s          median {:.2} (min {:.2}, max {:.2}) over {} runs",
@@ -105,6 +114,10 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     println!(
         "per ray          {:.2} nodes, {:.2} leaves, {:.2} triangle tests",
         report.nodes_per_ray, report.leaves_per_ray, report.isects_per_ray
+    );
+    println!(
+        "per packet       N {:.2} nodes, I {:.2} tests, {:.1}% of packet/leaf visits culled",
+        report.nodes_per_packet, report.isects_per_packet, report.culled_percent
     );
     Ok(())
 }

@@ -35,18 +35,24 @@ pub(super) fn child_boxes(b: &Aabb, axis: usize, split: f32) -> (Aabb, Aabb) {
     (l, r)
 }
 
-/// Tests the leaf `ids` with box `bounds` against packets `set` of `tile`, culling packets whose rays miss
-/// the box when `cull` is on. Returns true when some lane's closest hit changed.
+/// A leaf reached by a frustum walk: its triangle ids and its box.
+pub(super) struct Leaf<'a> {
+    pub tree: &'a KdTree,
+    pub ids: std::ops::Range<usize>,
+    pub bounds: Aabb,
+}
+
+/// Tests `leaf` against packets `set` of `tile`, culling packets whose rays miss its box when `cull` is on.
+/// Returns true when some lane's closest hit changed.
 pub(super) fn leaf_intersect<V: Vf32>(
-    tree: &KdTree,
-    ids: std::ops::Range<usize>,
-    bounds: &Aabb,
+    leaf: &Leaf,
     tile: &mut PacketTile<V>,
     set: &[usize],
     cull: bool,
     stats: &mut TraversalStats,
 ) -> bool {
-    let ids = &tree.tri_ids()[ids];
+    let (tree, bounds) = (leaf.tree, &leaf.bounds);
+    let ids = &tree.tri_ids()[leaf.ids.clone()];
     if ids.is_empty() {
         return false;
     }
@@ -59,6 +65,7 @@ pub(super) fn leaf_intersect<V: Vf32>(
             stats.packets_culled += 1;
             continue;
         }
+        stats.packets_tested += 1;
         for &id in ids {
             stats.isect_tests += 1;
             changed |= intersect_packet(p, hits, tree.triangles().get(id), id, active).any();
@@ -69,16 +76,15 @@ pub(super) fn leaf_intersect<V: Vf32>(
 
 /// Any-hit counterpart of [`leaf_intersect`]: marks lanes blocked by the leaf's triangles in `blocked`.
 pub(super) fn leaf_occlude<V: Vf32>(
-    tree: &KdTree,
-    ids: std::ops::Range<usize>,
-    bounds: &Aabb,
+    leaf: &Leaf,
     tile: &PacketTile<V>,
     set: &[usize],
     cull: bool,
     blocked: &mut [V::Mask],
     stats: &mut TraversalStats,
 ) {
-    let ids = &tree.tri_ids()[ids];
+    let (tree, bounds) = (leaf.tree, &leaf.bounds);
+    let ids = &tree.tri_ids()[leaf.ids.clone()];
     if ids.is_empty() {
         return;
     }
@@ -95,6 +101,7 @@ pub(super) fn leaf_occlude<V: Vf32>(
                 continue;
             }
         }
+        stats.packets_tested += 1;
         for &id in ids {
             stats.isect_tests += 1;
             blocked[j] = blocked[j] | occlude_packet(p, tree.triangles().get(id), open);
@@ -127,9 +134,9 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let mut limit = f32::INFINITY;
-        self.traverse_frustum(f, stats, |tree, ids, bounds, stats| {
-            if leaf_intersect(tree, ids, bounds, tile, set, cull, stats) {
-                limit = hit_limit(tile, set) * f.t_scale;
+        self.traverse_frustum(f, stats, |leaf, stats| {
+            if leaf_intersect(leaf, tile, set, cull, stats) {
+                limit = hit_limit(tile, set);
             }
             (limit, false)
         });
@@ -146,20 +153,20 @@ impl KdTree {
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
-        self.traverse_frustum(f, stats, |tree, ids, bounds, stats| {
-            leaf_occlude(tree, ids, bounds, tile, set, cull, blocked, stats);
+        self.traverse_frustum(f, stats, |leaf, stats| {
+            leaf_occlude(leaf, tile, set, cull, blocked, stats);
             let all = set.iter().all(|&j| (tile.packets[j].valid & !blocked[j]).none());
             (f32::INFINITY, all)
         });
     }
 
-    /// Walks the leaves the frustum overlaps, roughly front to back. `leaf(tree, ids, box, stats)` returns
-    /// the distance beyond which no ray needs more leaves, and whether the walk can stop.
+    /// Walks the leaves the frustum overlaps, roughly front to back. `leaf(leaf, stats)` returns the distance
+    /// beyond which no ray needs more leaves, and whether the walk can stop.
     fn traverse_frustum(
         &self,
         f: &Frustum,
         stats: &mut TraversalStats,
-        mut leaf: impl FnMut(&KdTree, std::ops::Range<usize>, &Aabb, &mut TraversalStats) -> (f32, bool),
+        mut leaf: impl FnMut(&Leaf, &mut TraversalStats) -> (f32, bool),
     ) {
         if self.triangles().is_empty() {
             return;
@@ -191,7 +198,7 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let (limit, stop) = leaf(self, n.leaf_range(), &bounds, stats);
+            let (limit, stop) = leaf(&Leaf { tree: self, ids: n.leaf_range(), bounds }, stats);
             if stop {
                 break;
             }

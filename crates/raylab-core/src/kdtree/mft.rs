@@ -9,7 +9,7 @@
 
 use raylab_simd::{VMask, Vf32};
 
-use super::frustum::{child_boxes, hit_limit, leaf_intersect, leaf_occlude};
+use super::frustum::{Leaf, child_boxes, hit_limit, leaf_intersect, leaf_occlude};
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::Aabb;
@@ -26,7 +26,6 @@ pub struct Frustum4<V: Vf32> {
     neg_far: [V; 3],
     t_min: V,
     t_max: V,
-    t_scale: [f32; 4],
     origin_slack: f32,
     /// Lanes that hold a frustum.
     valid: V::Mask,
@@ -51,7 +50,6 @@ impl<V: Vf32> Frustum4<V> {
             neg_far: axes(&|x, k| x.neg_far[k], f32::NEG_INFINITY),
             t_min: lanes(&|x| x.t_min, f32::INFINITY),
             t_max: lanes(&|x| x.t_max, f32::NEG_INFINITY),
-            t_scale: f.map(|x| x.map_or(1.0, |x| x.t_scale)),
             origin_slack: f.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack)),
             valid: V::Mask::from_bits(valid),
         })
@@ -93,10 +91,10 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let mut limit = [f32::INFINITY; 4];
-        self.traverse_mft(f, stats, |tree, ids, bounds, active, stats| {
+        self.traverse_mft(f, stats, |leaf, active, stats| {
             for (i, set) in sets.iter().enumerate() {
-                if active >> i & 1 == 1 && leaf_intersect(tree, ids.clone(), bounds, tile, set, cull, stats) {
-                    limit[i] = hit_limit(tile, set) * f.t_scale[i];
+                if active >> i & 1 == 1 && leaf_intersect(leaf, tile, set, cull, stats) {
+                    limit[i] = hit_limit(tile, set);
                 }
             }
             (V::from_slice(&limit), 0)
@@ -115,10 +113,10 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let mut done = 0u32;
-        self.traverse_mft(f, stats, |tree, ids, bounds, active, stats| {
+        self.traverse_mft(f, stats, |leaf, active, stats| {
             for (i, set) in sets.iter().enumerate() {
                 if active >> i & 1 == 1 {
-                    leaf_occlude(tree, ids.clone(), bounds, tile, set, cull, blocked, stats);
+                    leaf_occlude(leaf, tile, set, cull, blocked, stats);
                     if set.iter().all(|&j| (tile.packets[j].valid & !blocked[j]).none()) {
                         done |= 1 << i;
                     }
@@ -128,13 +126,13 @@ impl KdTree {
         });
     }
 
-    /// Walks the leaves the four frustums overlap. `leaf(tree, ids, box, active_bits, stats)` returns each
-    /// lane's distance limit and the lanes that are finished.
+    /// Walks the leaves the four frustums overlap. `leaf(leaf, active_bits, stats)` returns each lane's
+    /// distance limit and the lanes that are finished.
     fn traverse_mft<V: Vf32>(
         &self,
         f: &Frustum4<V>,
         stats: &mut TraversalStats,
-        mut leaf: impl FnMut(&KdTree, std::ops::Range<usize>, &Aabb, u32, &mut TraversalStats) -> (V, u32),
+        mut leaf: impl FnMut(&Leaf, u32, &mut TraversalStats) -> (V, u32),
     ) {
         if self.triangles().is_empty() || f.valid.none() {
             return;
@@ -179,7 +177,8 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let (limit, finished) = leaf(self, n.leaf_range(), &bounds, (active & !done).bits(), stats);
+            let (limit, finished) =
+                leaf(&Leaf { tree: self, ids: n.leaf_range(), bounds }, (active & !done).bits(), stats);
             done = done | V::Mask::from_bits(finished);
             if (f.valid & !done).none() {
                 break;

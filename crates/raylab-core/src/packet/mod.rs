@@ -31,6 +31,8 @@ pub struct RayPacket<V: Vf32> {
     pub tmax: V,
     /// Lanes that hold a ray.
     pub valid: V::Mask,
+    /// True when no lane has a zero direction component (the slab tests can skip their special case).
+    pub finite_inv: bool,
     /// Per lane, masks for "axis index is 0" and "axis index is 1" of `kx`, `ky`, `kz` (Woop et al.).
     pub(crate) axis_is: [[V::Mask; 2]; 3],
     /// Per lane shear constants.
@@ -60,7 +62,8 @@ impl<V: Vf32> RayPacket<V> {
             }
             V::from_slice(&a[..V::LANES])
         };
-        let shears: Vec<RayShear> = lanes[..V::LANES].iter().map(RayShear::new).collect();
+        let shears: [RayShear; MAX_LANES] = std::array::from_fn(|i| RayShear::new(&lanes[i]));
+        let shears = &shears[..V::LANES];
         let axis_is = [0usize, 1, 2].map(|j| {
             let bits = |want: usize| {
                 shears.iter().enumerate().fold(0u32, |m, (i, s)| m | (((s.axes()[j] == want) as u32) << i))
@@ -69,15 +72,18 @@ impl<V: Vf32> RayPacket<V> {
         });
         let shear_v = [0usize, 1, 2].map(|j| {
             let mut a = [0.0f32; MAX_LANES];
-            for (x, s) in a.iter_mut().zip(&shears) {
+            for (x, s) in a.iter_mut().zip(shears) {
                 *x = s.shear()[j];
             }
             V::from_slice(&a[..V::LANES])
         });
+        let inv = [gather(&|r| 1.0 / r.dir.x), gather(&|r| 1.0 / r.dir.y), gather(&|r| 1.0 / r.dir.z)];
+        let finite_inv = lanes[..V::LANES].iter().all(|r| (Vec3::ONE / r.dir).is_finite());
         Self {
             org: [gather(&|r| r.origin.x), gather(&|r| r.origin.y), gather(&|r| r.origin.z)],
             dir: [gather(&|r| r.dir.x), gather(&|r| r.dir.y), gather(&|r| r.dir.z)],
-            inv: [gather(&|r| 1.0 / r.dir.x), gather(&|r| 1.0 / r.dir.y), gather(&|r| 1.0 / r.dir.z)],
+            inv,
+            finite_inv,
             tmin: gather(&|r| r.tmin),
             tmax: gather(&|r| r.tmax),
             valid: V::Mask::from_bits(valid),

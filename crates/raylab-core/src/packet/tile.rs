@@ -77,28 +77,38 @@ impl<V: Vf32> PacketTile<V> {
 /// thesis 4.1.4), with the slab test's handling of zero direction components.
 #[inline(always)]
 pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -> V::Mask {
-    let inf = V::splat(f32::INFINITY);
     let mut t0 = p.tmin;
     let mut t1 = limit;
-    for k in 0..3 {
-        let (lo, hi) = (V::splat(b.min[k]), V::splat(b.max[k]));
-        let parallel = p.inv[k].abs().eq(inf);
-        let outside = p.org[k].lt(lo) | p.org[k].gt(hi);
-        let ta = (lo - p.org[k]) * p.inv[k];
-        let tb = (hi - p.org[k]) * p.inv[k];
-        let enter = V::select(parallel, V::select(outside, inf, V::splat(f32::NEG_INFINITY)), ta.min(tb));
-        let exit = V::select(parallel, V::select(outside, V::splat(f32::NEG_INFINITY), inf), ta.max(tb));
-        t0 = t0.max(enter);
-        t1 = t1.min(exit);
+    if p.finite_inv {
+        for k in 0..3 {
+            let ta = (V::splat(b.min[k]) - p.org[k]) * p.inv[k];
+            let tb = (V::splat(b.max[k]) - p.org[k]) * p.inv[k];
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+    } else {
+        let inf = V::splat(f32::INFINITY);
+        for k in 0..3 {
+            let (lo, hi) = (V::splat(b.min[k]), V::splat(b.max[k]));
+            let parallel = p.inv[k].abs().eq(inf);
+            let outside = p.org[k].lt(lo) | p.org[k].gt(hi);
+            let ta = (lo - p.org[k]) * p.inv[k];
+            let tb = (hi - p.org[k]) * p.inv[k];
+            let enter = V::select(parallel, V::select(outside, inf, V::splat(f32::NEG_INFINITY)), ta.min(tb));
+            let exit = V::select(parallel, V::select(outside, V::splat(f32::NEG_INFINITY), inf), ta.max(tb));
+            t0 = t0.max(enter);
+            t1 = t1.min(exit);
+        }
     }
     p.valid & (t0 * V::splat(1.0 - slack)).le(t1 * V::splat(1.0 + slack))
 }
 
-/// Bounds, for every axis, of the distances at which the rays of a bundle from one common origin cross an
+/// Bounds, for every axis, of the parameters at which the rays of a bundle from one common origin cross an
 /// axis-aligned plane: the interval form of a frustum (thesis 2.3.2 and Listing 4.2, with the omni-directional
-/// changes of 4.1.2). Distances are measured along unit directions from `origin`.
+/// changes of 4.1.2). Parameters are each ray's own `t`; an interval `[near, far]` holds every `t` at which
+/// some ray of the bundle is inside a cell, so rays need not have unit directions.
 ///
-/// For a plane at signed distance `dist = split - origin[k]`, a ray with unit direction `u` crosses it at
+/// For a plane at signed distance `dist = split - origin[k]`, a ray with direction `u` crosses it at
 /// `dist / u_k` when that is positive, and never otherwise. With `dist > 0` only rays with `1/u_k > 0` cross,
 /// at `dist * [min, max]` of those inverses, and any ray going the other way makes the far bound infinite;
 /// `dist < 0` mirrors this with the negative inverses. So four precomputed factors per axis give both bounds
@@ -119,9 +129,6 @@ pub struct Frustum {
     pub t_min: f32,
     /// Largest end distance of the rays.
     pub t_max: f32,
-    /// Factor that turns a ray's own hit distance into a distance along a unit direction: the largest
-    /// direction length in the bundle (1 for unit directions), so that hit limits stay conservative.
-    pub t_scale: f32,
     /// Distance by which the bundle's segments may miss `origin` (0 for rays that start there). Shadow rays
     /// traced from the light end at `p + d * t_max`, which rounding puts a little off the light; planes
     /// closer than this to the origin are crossed in both directions, and crossing bounds widen by it.
@@ -129,9 +136,7 @@ pub struct Frustum {
 }
 
 impl Frustum {
-    /// The frustum of segments `(unit direction, start, end)` from `origin`, distances along the unit
-    /// directions; `None` for an empty bundle. Set [`Frustum::t_scale`] when the rays' own directions are
-    /// not unit vectors.
+    /// The frustum of segments `(direction, start, end)` from `origin`; `None` for an empty bundle.
     pub fn bounding(origin: Vec3, segments: impl IntoIterator<Item = (Vec3, f32, f32)>) -> Option<Self> {
         let mut f = Frustum {
             origin,
@@ -141,7 +146,6 @@ impl Frustum {
             neg_far: [f32::INFINITY; 3],
             t_min: f32::INFINITY,
             t_max: f32::NEG_INFINITY,
-            t_scale: 1.0,
             origin_slack: 0.0,
         };
         let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
@@ -175,6 +179,59 @@ impl Frustum {
             }
         }
         f.t_min = f.t_min.max(0.0);
+        Some(f)
+    }
+
+    /// The frustum of the valid rays of `packets[set]`, which must all start at `origin`, from the packets'
+    /// inverse directions (no division per ray).
+    pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>], set: &[usize]) -> Option<Self> {
+        let inf = V::splat(f32::INFINITY);
+        let ninf = V::splat(f32::NEG_INFINITY);
+        let zero = V::splat(0.0);
+        let (mut pos_near, mut pos_far, mut neg_near, mut neg_far) = ([inf; 3], [ninf; 3], [ninf; 3], [inf; 3]);
+        let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
+        let (mut t_min, mut t_max) = (inf, ninf);
+        let mut any = false;
+        for &j in set {
+            let p = &packets[j];
+            if p.valid.none() {
+                continue;
+            }
+            any = true;
+            t_min = V::select(p.valid, p.tmin.min(t_min), t_min);
+            t_max = V::select(p.valid, p.tmax.max(t_max), t_max);
+            for k in 0..3 {
+                let pos = p.valid & p.inv[k].gt(zero);
+                let neg = p.valid & !p.inv[k].gt(zero);
+                any_pos[k] |= pos.any();
+                any_neg[k] |= neg.any();
+                pos_near[k] = V::select(pos, p.inv[k].min(pos_near[k]), pos_near[k]);
+                pos_far[k] = V::select(pos, p.inv[k].max(pos_far[k]), pos_far[k]);
+                neg_near[k] = V::select(neg, p.inv[k].max(neg_near[k]), neg_near[k]);
+                neg_far[k] = V::select(neg, p.inv[k].min(neg_far[k]), neg_far[k]);
+            }
+        }
+        if !any {
+            return None;
+        }
+        let mut f = Frustum {
+            origin,
+            pos_near: pos_near.map(|v| v.reduce_min()),
+            pos_far: pos_far.map(|v| v.reduce_max()),
+            neg_near: neg_near.map(|v| v.reduce_max()),
+            neg_far: neg_far.map(|v| v.reduce_min()),
+            t_min: t_min.reduce_min().max(0.0),
+            t_max: t_max.reduce_max(),
+            origin_slack: 0.0,
+        };
+        for k in 0..3 {
+            if any_neg[k] || !any_pos[k] {
+                f.pos_far[k] = f32::INFINITY;
+            }
+            if any_pos[k] || !any_neg[k] {
+                f.neg_far[k] = f32::NEG_INFINITY;
+            }
+        }
         Some(f)
     }
 

@@ -125,7 +125,7 @@ impl<'a> Tracer<'a> {
         stats.rays += rays.iter().flatten().filter(|r| r.is_valid()).count() as u64;
         stats.packets += tile.packets.len() as u64;
         match self.options.method {
-            Method::Frustum => match common_origin_frustum(rays) {
+            Method::Frustum => match common_origin_frustum(&tile, &all) {
                 Some(f) => self.tree.intersect_frustum(&f, &mut tile, &all, self.options.cull, stats),
                 None => self.packets_intersect(&mut tile, stats),
             },
@@ -160,7 +160,7 @@ impl<'a> Tracer<'a> {
         let all: Vec<usize> = (0..tile.packets.len()).collect();
         stats.rays += rays.iter().flatten().filter(|r| r.is_valid()).count() as u64;
         stats.packets += tile.packets.len() as u64;
-        let frustum = || common_origin_frustum(rays).or_else(|| toward.and_then(|t| toward_frustum(rays, t)));
+        let frustum = || common_origin_frustum(&tile, &all).or_else(|| toward.and_then(|t| toward_frustum(rays, t)));
         let traced = match self.options.method {
             Method::Frustum => frustum().map(|f| {
                 self.tree.occluded_frustum(&f, &tile, &all, self.options.cull, &mut blocked, stats);
@@ -175,8 +175,8 @@ impl<'a> Tracer<'a> {
                 *b = self.tree.occluded_packet(p, stats);
             }
         }
-        for j in 0..tile.packets.len() {
-            let bits = blocked[j].bits();
+        for (j, b) in blocked.iter().enumerate() {
+            let bits = b.bits();
             tile.for_each_lane(j, |pixel, lane| out[pixel] = bits >> lane & 1 == 1);
         }
     }
@@ -198,17 +198,20 @@ impl<'a> Tracer<'a> {
             if x0 >= x1 || y0 >= y1 {
                 continue;
             }
-            let sub: Vec<Option<Ray>> =
-                (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| rays[y * w + x]).collect();
-            if sub.iter().all(Option::is_none) {
+            let set = tile.packets_in(x0, y0, x1, y1);
+            if set.iter().all(|&j| tile.packets[j].valid.none()) {
                 continue;
             }
-            let f = match toward {
-                None => common_origin_frustum(&sub)?,
-                Some(t) => common_origin_frustum(&sub).or_else(|| toward_frustum(&sub, t))?,
+            let f = match common_origin_frustum(tile, &set) {
+                Some(f) => f,
+                None => {
+                    let sub: Vec<Option<Ray>> =
+                        (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| rays[y * w + x]).collect();
+                    toward_frustum(&sub, toward?)?
+                }
             };
             frustums[i] = Some(f);
-            sets[i] = tile.packets_in(x0, y0, x1, y1);
+            sets[i] = set;
         }
         // All four must share one origin.
         let first = frustums.iter().flatten().next()?.origin;
@@ -219,24 +222,25 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// The frustum of rays that all start at one point, or `None` when they do not.
-fn common_origin_frustum(rays: &[Option<Ray>]) -> Option<Frustum> {
-    let mut valid = rays.iter().flatten().filter(|r| r.is_valid());
-    let origin = valid.next()?.origin;
-    if !rays.iter().flatten().filter(|r| r.is_valid()).all(|r| r.origin == origin) {
+/// The frustum of the packets `set` of `tile` when all their rays start at one point, else `None`.
+fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Frustum> {
+    let origin = set
+        .iter()
+        .find_map(|&j| {
+            let p = &tile.packets[j];
+            let first = p.valid.bits().trailing_zeros() as usize;
+            (first < V::LANES).then(|| *p.ray(first))
+        })?
+        .origin;
+    let same = set.iter().all(|&j| {
+        let p = &tile.packets[j];
+        let bits = p.valid.bits();
+        (0..V::LANES).filter(|i| bits >> i & 1 == 1).all(|i| p.ray(i).origin == origin)
+    });
+    if !same {
         return None;
     }
-    let mut scale = 0.0f32;
-    let mut f = Frustum::bounding(
-        origin,
-        rays.iter().flatten().filter(|r| r.is_valid()).map(|r| {
-            let len = r.dir.length();
-            scale = scale.max(len);
-            (r.dir / len, r.tmin * len, r.tmax * len)
-        }),
-    )?;
-    f.t_scale = scale;
-    Some(f)
+    Frustum::from_packets(origin, &tile.packets, set)
 }
 
 /// The frustum, seen from `toward`, of segments that end there (shadow rays to a light): the thesis traces
