@@ -45,6 +45,12 @@ pub struct CompareArgs {
     /// Acceleration-structure builds per thread count (the median is reported).
     #[arg(long, default_value_t = 3, value_parser = in_range(1, 100))]
     builds: u64,
+    /// Coherent methods to measure beside Embree's packet and stream APIs (primary and shadow rays).
+    #[arg(long, value_delimiter = ',', default_value = "packet,frustum,mft")]
+    methods: Vec<Method>,
+    /// Tile sizes for the frustum methods.
+    #[arg(long, value_delimiter = ',', default_value = "4,8,16,32,64", value_parser = in_range(2, 256))]
+    tiles: Vec<u64>,
     /// Also write the markdown to this file.
     #[arg(long)]
     markdown: Option<PathBuf>,
@@ -75,7 +81,7 @@ fn run_embree(a: &CompareArgs, cam: &raylab_core::scene::Camera, light: glam::Ve
         .args(["--width", &a.width.to_string(), "--height", &a.height.to_string()])
         .args(["--threads", &threads.join(","), "--reps", &a.reps.to_string()])
         .args(["--warmup", &a.warmup.to_string(), "--builds", &a.builds.to_string()])
-        .args(["--kinds", "primary_1,shadow_1,diffuse_1"])
+        .args(["--kinds", "all"])
         .output()
         .map_err(|e| format!("--embree: cannot run {}: {e}", a.embree.display()))?;
     let text = String::from_utf8_lossy(&out.stdout);
@@ -149,6 +155,25 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         }
     }
 
+    // Coherent methods: primary and shadow rays, every tile size for the frustum methods.
+    let mut coherent: Vec<(Method, u64, TraceReport)> = Vec::new();
+    for kind in [RayKind::Primary, RayKind::Shadow] {
+        let workload = wb.build(kind);
+        for &method in a.methods.iter().filter(|m| m.uses_packets()) {
+            let tiles: Vec<u64> = if method.uses_tiles() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
+            for &tile in &tiles {
+                for &t in &a.threads {
+                    let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
+                    let (report, results) =
+                        measure(&tracer, &workload, tile as u32, t as usize, a.warmup as usize, a.reps as usize)?;
+                    validate(&reference, &workload, &results, 256)
+                        .map_err(|m| format!("validation failed ({method} tile {tile}): {m}"))?;
+                    coherent.push((method, tile, report));
+                }
+            }
+        }
+    }
+
     let mut md = String::new();
     let cmd: Vec<String> = std::env::args().collect();
     let _ = writeln!(md, "Machine and build: {}.", env.line());
@@ -198,6 +223,47 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     for (t, s) in &builds {
         let e = embree.builds.iter().find(|(et, _)| et == t).map_or("n/a".into(), |(_, s)| format!("{s:.3}"));
         let _ = writeln!(md, "| median of {} | {} | {:.3} | {} |", a.builds, t, s, e);
+    }
+    if !coherent.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nCoherent methods against Embree's best packet or stream API for the same rays and thread count \
+             (N = nodes per 2x2 packet, I = triangle tests per 2x2 packet, culled = packet/leaf visits culled):\n"
+        );
+        let _ = writeln!(md, "| rays | threads | method | tile | Mrays/s (min-max) | N | I | culled | Embree best | Embree Mrays/s | raylab / Embree | check |");
+        let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|---|");
+        for (method, tile, r) in &coherent {
+            let prefix = if r.kind.is_occlusion() { "shadow_" } else { "primary_" };
+            let best = embree
+                .rows
+                .iter()
+                .filter(|e| e.kind.starts_with(prefix) && !e.kind.ends_with("_1") && e.threads == r.threads as u64)
+                .max_by(|x, y| x.median.total_cmp(&y.median));
+            let (bname, bval, ratio) = match best {
+                Some(e) => (e.kind.clone(), format!("{:.2}", e.median), format!("{:.2}x", r.mrays_median / e.median)),
+                None => ("n/a".into(), "n/a".into(), "n/a".into()),
+            };
+            let check =
+                if r.kind.is_occlusion() { format!("{} occluded", r.hits) } else { format!("{} hits, {:.1}", r.hits, r.sum_t) };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {:.2} ({:.2}-{:.2}) | {:.2} | {:.2} | {:.1}% | {} | {} | {} | {} |",
+                r.kind,
+                r.threads,
+                method,
+                tile,
+                r.mrays_median,
+                r.mrays_min,
+                r.mrays_max,
+                r.nodes_per_packet,
+                r.isects_per_packet,
+                r.culled_percent,
+                bname,
+                bval,
+                ratio,
+                check
+            );
+        }
     }
     print!("{md}");
     if let Some(p) = &a.markdown {
