@@ -230,7 +230,10 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             "\nCoherent methods against Embree's best packet or stream API for the same rays and thread count \
              (N = nodes per 2x2 packet, I = triangle tests per 2x2 packet, culled = packet/leaf visits culled):\n"
         );
-        let _ = writeln!(md, "| rays | threads | method | tile | Mrays/s (min-max) | N | I | culled | Embree best | Embree Mrays/s | raylab / Embree | check |");
+        let _ = writeln!(
+            md,
+            "| rays | threads | method | tile | Mrays/s (min-max) | N | I | culled | Embree best | Embree Mrays/s | raylab / Embree | check |"
+        );
         let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|---|");
         for (method, tile, r) in &coherent {
             let prefix = if r.kind.is_occlusion() { "shadow_" } else { "primary_" };
@@ -243,8 +246,11 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                 Some(e) => (e.kind.clone(), format!("{:.2}", e.median), format!("{:.2}x", r.mrays_median / e.median)),
                 None => ("n/a".into(), "n/a".into(), "n/a".into()),
             };
-            let check =
-                if r.kind.is_occlusion() { format!("{} occluded", r.hits) } else { format!("{} hits, {:.1}", r.hits, r.sum_t) };
+            let check = if r.kind.is_occlusion() {
+                format!("{} occluded", r.hits)
+            } else {
+                format!("{} hits, {:.1}", r.hits, r.sum_t)
+            };
             let _ = writeln!(
                 md,
                 "| {} | {} | {} | {} | {:.2} ({:.2}-{:.2}) | {:.2} | {:.2} | {:.1}% | {} | {} | {} | {} |",

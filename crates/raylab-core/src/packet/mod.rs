@@ -48,47 +48,45 @@ impl<V: Vf32> RayPacket<V> {
         assert!(rays.len() <= V::LANES && V::LANES <= MAX_LANES);
         let filler = Ray::new(Vec3::ZERO, Vec3::Z);
         let mut lanes = [filler; MAX_LANES];
+        // Per field, the lane values; one pass over the lanes fills them all.
+        let mut f = [[0.0f32; MAX_LANES]; 14];
         let mut valid = 0u32;
-        for (i, r) in rays.iter().enumerate() {
-            if let Some(r) = r.filter(|r| r.is_valid()) {
+        let mut axis_bits = [[0u32; 2]; 3];
+        let mut finite_inv = true;
+        for i in 0..V::LANES {
+            if let Some(r) = rays.get(i).copied().flatten().filter(|r| r.is_valid()) {
                 lanes[i] = r;
                 valid |= 1 << i;
             }
+            let r = &lanes[i];
+            let inv = Vec3::ONE / r.dir;
+            finite_inv &= inv.is_finite();
+            let shear = RayShear::new(r);
+            for (j, &k) in shear.axes().iter().enumerate() {
+                axis_bits[j][0] |= ((k == 0) as u32) << i;
+                axis_bits[j][1] |= ((k == 1) as u32) << i;
+            }
+            let [sx, sy, sz] = shear.shear();
+            let values = [
+                r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z, inv.x, inv.y, inv.z, r.tmin, r.tmax, sx,
+                sy, sz,
+            ];
+            for (field, v) in f.iter_mut().zip(values) {
+                field[i] = v;
+            }
         }
-        let gather = |f: &dyn Fn(&Ray) -> f32| {
-            let mut a = [0.0f32; MAX_LANES];
-            for (x, r) in a.iter_mut().zip(&lanes) {
-                *x = f(r);
-            }
-            V::from_slice(&a[..V::LANES])
-        };
-        let shears: [RayShear; MAX_LANES] = std::array::from_fn(|i| RayShear::new(&lanes[i]));
-        let shears = &shears[..V::LANES];
-        let axis_is = [0usize, 1, 2].map(|j| {
-            let bits = |want: usize| {
-                shears.iter().enumerate().fold(0u32, |m, (i, s)| m | (((s.axes()[j] == want) as u32) << i))
-            };
-            [V::Mask::from_bits(bits(0)), V::Mask::from_bits(bits(1))]
-        });
-        let shear_v = [0usize, 1, 2].map(|j| {
-            let mut a = [0.0f32; MAX_LANES];
-            for (x, s) in a.iter_mut().zip(shears) {
-                *x = s.shear()[j];
-            }
-            V::from_slice(&a[..V::LANES])
-        });
-        let inv = [gather(&|r| 1.0 / r.dir.x), gather(&|r| 1.0 / r.dir.y), gather(&|r| 1.0 / r.dir.z)];
-        let finite_inv = lanes[..V::LANES].iter().all(|r| (Vec3::ONE / r.dir).is_finite());
+        let v = |k: usize| V::from_slice(&f[k][..V::LANES]);
+        let m = |bits: [u32; 2]| [V::Mask::from_bits(bits[0]), V::Mask::from_bits(bits[1])];
         Self {
-            org: [gather(&|r| r.origin.x), gather(&|r| r.origin.y), gather(&|r| r.origin.z)],
-            dir: [gather(&|r| r.dir.x), gather(&|r| r.dir.y), gather(&|r| r.dir.z)],
-            inv,
+            org: [v(0), v(1), v(2)],
+            dir: [v(3), v(4), v(5)],
+            inv: [v(6), v(7), v(8)],
             finite_inv,
-            tmin: gather(&|r| r.tmin),
-            tmax: gather(&|r| r.tmax),
+            tmin: v(9),
+            tmax: v(10),
             valid: V::Mask::from_bits(valid),
-            axis_is,
-            shear: shear_v,
+            axis_is: [m(axis_bits[0]), m(axis_bits[1]), m(axis_bits[2])],
+            shear: [v(11), v(12), v(13)],
             rays: lanes,
         }
     }
