@@ -8,7 +8,6 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
 use crate::ray::{Hit, Ray};
-use crate::triangle::RayShear;
 
 pub use tile::{Frustum, PacketTile, overlaps_box};
 pub use woop::{intersect_packet, occlude_packet};
@@ -37,8 +36,9 @@ pub struct RayPacket<V: Vf32> {
     pub(crate) axis_is: [[V::Mask; 2]; 3],
     /// Per lane shear constants.
     pub(crate) shear: [V; 3],
-    /// The rays themselves, for the exact scalar fallback of the watertight test.
-    pub(crate) rays: [Ray; MAX_LANES],
+    /// `(kx, ky, kz)` when every valid lane has the same ones (the common case for coherent rays), so the
+    /// watertight test can index instead of selecting per lane.
+    pub(crate) uniform_axes: Option<[usize; 3]>,
 }
 
 impl<V: Vf32> RayPacket<V> {
@@ -46,54 +46,82 @@ impl<V: Vf32> RayPacket<V> {
     /// their lane empty too.
     pub fn new(rays: &[Option<Ray>]) -> Self {
         assert!(rays.len() <= V::LANES && V::LANES <= MAX_LANES);
-        let filler = Ray::new(Vec3::ZERO, Vec3::Z);
-        let mut lanes = [filler; MAX_LANES];
-        // Per field, the lane values; one pass over the lanes fills them all.
-        let mut f = [[0.0f32; MAX_LANES]; 14];
+        // Gather the raw fields; empty lanes get a harmless ray along +z.
+        let mut f = [[0.0f32; MAX_LANES]; 8];
         let mut valid = 0u32;
-        let mut axis_bits = [[0u32; 2]; 3];
-        let mut finite_inv = true;
         for i in 0..V::LANES {
-            if let Some(r) = rays.get(i).copied().flatten().filter(|r| r.is_valid()) {
-                lanes[i] = r;
-                valid |= 1 << i;
-            }
-            let r = &lanes[i];
-            let inv = Vec3::ONE / r.dir;
-            finite_inv &= inv.is_finite();
-            let shear = RayShear::new(r);
-            for (j, &k) in shear.axes().iter().enumerate() {
-                axis_bits[j][0] |= ((k == 0) as u32) << i;
-                axis_bits[j][1] |= ((k == 1) as u32) << i;
-            }
-            let [sx, sy, sz] = shear.shear();
-            let values = [
-                r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z, inv.x, inv.y, inv.z, r.tmin, r.tmax, sx,
-                sy, sz,
-            ];
+            let r = match rays.get(i).copied().flatten() {
+                Some(r) if r.is_valid() => {
+                    valid |= 1 << i;
+                    r
+                }
+                _ => Ray::new(Vec3::ZERO, Vec3::Z),
+            };
+            let values = [r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z, r.tmin, r.tmax];
             for (field, v) in f.iter_mut().zip(values) {
                 field[i] = v;
             }
         }
         let v = |k: usize| V::from_slice(&f[k][..V::LANES]);
-        let m = |bits: [u32; 2]| [V::Mask::from_bits(bits[0]), V::Mask::from_bits(bits[1])];
+        let dir = [v(3), v(4), v(5)];
+        let one = V::splat(1.0);
+        let inv = [one / dir[0], one / dir[1], one / dir[2]];
+        let inf = V::splat(f32::INFINITY);
+        let finite_inv = (inv[0].abs().lt(inf) & inv[1].abs().lt(inf) & inv[2].abs().lt(inf)).bits()
+            == V::Mask::from_bits(u32::MAX).bits();
+        // The watertight test's per-ray constants, computed per lane with the scalar test's exact operations
+        // (`RayShear::new`): kz is the axis of the largest |d| (ties to the lower axis), kx and ky follow it
+        // cyclically and swap when d[kz] is negative.
+        let [ax, ay, az] = dir.map(|d| d.abs());
+        let kz0 = ax.ge(ay) & ax.ge(az);
+        let kz1 = !kz0 & ay.ge(az);
+        let kz2 = !(kz0 | kz1);
+        let d_kz = V::select(kz0, dir[0], V::select(kz1, dir[1], dir[2]));
+        let neg = d_kz.lt(V::splat(0.0));
+        let pos = !neg;
+        let kx0 = (kz2 & pos) | (kz1 & neg);
+        let kx1 = (kz0 & pos) | (kz2 & neg);
+        let ky0 = (kz1 & pos) | (kz2 & neg);
+        let ky1 = (kz2 & pos) | (kz0 & neg);
+        let pick = |is0: V::Mask, is1: V::Mask| V::select(is0, dir[0], V::select(is1, dir[1], dir[2]));
+        let sz = one / d_kz;
+        let sx = pick(kx0, kx1) * sz;
+        let sy = pick(ky0, ky1) * sz;
+        let valid_mask = V::Mask::from_bits(valid);
+        let axis_of = |is0: V::Mask, is1: V::Mask| {
+            let (b0, b1, v) = ((is0 & valid_mask).bits(), (is1 & valid_mask).bits(), valid_mask.bits());
+            if b0 == v {
+                Some(0)
+            } else if b1 == v {
+                Some(1)
+            } else if (b0 | b1) == 0 {
+                Some(2)
+            } else {
+                None
+            }
+        };
+        let uniform_axes = match (axis_of(kx0, kx1), axis_of(ky0, ky1), axis_of(kz0, kz1)) {
+            (Some(x), Some(y), Some(z)) if valid != 0 => Some([x, y, z]),
+            _ => None,
+        };
         Self {
             org: [v(0), v(1), v(2)],
-            dir: [v(3), v(4), v(5)],
-            inv: [v(6), v(7), v(8)],
+            dir,
+            inv,
             finite_inv,
-            tmin: v(9),
-            tmax: v(10),
+            tmin: v(6),
+            tmax: v(7),
             valid: V::Mask::from_bits(valid),
-            axis_is: [m(axis_bits[0]), m(axis_bits[1]), m(axis_bits[2])],
-            shear: [v(11), v(12), v(13)],
-            rays: lanes,
+            axis_is: [[kx0, kx1], [ky0, ky1], [kz0, kz1]],
+            shear: [sx, sy, sz],
+            uniform_axes,
         }
     }
 
     /// The ray in lane `i`.
-    pub fn ray(&self, i: usize) -> &Ray {
-        &self.rays[i]
+    pub fn ray(&self, i: usize) -> Ray {
+        let c = |v: &[V; 3]| Vec3::new(v[0].lane(i), v[1].lane(i), v[2].lane(i));
+        Ray::segment(c(&self.org), c(&self.dir), self.tmin.lane(i), self.tmax.lane(i))
     }
 }
 

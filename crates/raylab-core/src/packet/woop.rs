@@ -26,15 +26,23 @@ struct LaneHits<V: Vf32> {
 
 #[inline(always)]
 fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
-    let rel = |v: Vec3| [V::splat(v.x) - p.org[0], V::splat(v.y) - p.org[1], V::splat(v.z) - p.org[2]];
-    let (a, b, c) = (rel(tri[0]), rel(tri[1]), rel(tri[2]));
-    let [kx, ky, kz] = p.axis_is;
+    // Corners relative to the origins, permuted into (kx, ky, kz) order: by indexing when every lane shares
+    // the permutation, by per-lane selects otherwise. Both give each lane exactly `v[k] - o[k]`.
     let [sx, sy, sz] = p.shear;
-    let permute =
-        |q: [V; 3]| (pick::<V>(kx, q[0], q[1], q[2]), pick::<V>(ky, q[0], q[1], q[2]), pick::<V>(kz, q[0], q[1], q[2]));
-    let (a_x, a_y, a_z) = permute(a);
-    let (b_x, b_y, b_z) = permute(b);
-    let (c_x, c_y, c_z) = permute(c);
+    let ((a_x, a_y, a_z), (b_x, b_y, b_z), (c_x, c_y, c_z)) = match p.uniform_axes {
+        Some([kx, ky, kz]) => {
+            let rel = |v: Vec3| (V::splat(v[kx]) - p.org[kx], V::splat(v[ky]) - p.org[ky], V::splat(v[kz]) - p.org[kz]);
+            (rel(tri[0]), rel(tri[1]), rel(tri[2]))
+        }
+        None => {
+            let rel = |v: Vec3| [V::splat(v.x) - p.org[0], V::splat(v.y) - p.org[1], V::splat(v.z) - p.org[2]];
+            let [kx, ky, kz] = p.axis_is;
+            let permute = |q: [V; 3]| {
+                (pick::<V>(kx, q[0], q[1], q[2]), pick::<V>(ky, q[0], q[1], q[2]), pick::<V>(kz, q[0], q[1], q[2]))
+            };
+            (permute(rel(tri[0])), permute(rel(tri[1])), permute(rel(tri[2])))
+        }
+    };
     let ax = a_x - sx * a_z;
     let ay = a_y - sy * a_z;
     let bx = b_x - sx * b_z;
@@ -74,7 +82,7 @@ fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) ->
         let mut hit_bits = mask.bits();
         for i in (0..V::LANES).filter(|i| bits >> i & 1 == 1) {
             let ray = p.ray(i);
-            if let Some(h) = crate::triangle::RayShear::new(ray).intersect(tri, ray.tmin, tmax.lane(i)) {
+            if let Some(h) = crate::triangle::RayShear::new(&ray).intersect(tri, ray.tmin, tmax.lane(i)) {
                 (ta[i], ua[i], va[i]) = (h.t, h.u, h.v);
                 hit_bits |= 1 << i;
             }

@@ -229,13 +229,14 @@ fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option
         .find_map(|&j| {
             let p = &tile.packets[j];
             let first = p.valid.bits().trailing_zeros() as usize;
-            (first < V::LANES).then(|| *p.ray(first))
+            (first < V::LANES).then(|| p.ray(first))
         })?
         .origin;
+    let o = [V::splat(origin.x), V::splat(origin.y), V::splat(origin.z)];
     let same = set.iter().all(|&j| {
         let p = &tile.packets[j];
-        let bits = p.valid.bits();
-        (0..V::LANES).filter(|i| bits >> i & 1 == 1).all(|i| p.ray(i).origin == origin)
+        let at_origin = p.org[0].eq(o[0]) & p.org[1].eq(o[1]) & p.org[2].eq(o[2]);
+        (p.valid & !at_origin).none()
     });
     if !same {
         return None;
