@@ -35,11 +35,13 @@ pub(super) fn child_boxes(b: &Aabb, axis: usize, split: f32) -> (Aabb, Aabb) {
     (l, r)
 }
 
-/// A leaf reached by a frustum walk: its triangle ids and its box.
+/// A leaf reached by a frustum walk: its triangle ids, its box, and the distance at which the bundle can
+/// first be inside it.
 pub(super) struct Leaf<'a> {
     pub tree: &'a KdTree,
     pub ids: std::ops::Range<usize>,
     pub bounds: Aabb,
+    pub near: f32,
 }
 
 /// Tests `leaf` against packets `set` of `tile`, culling packets whose rays miss its box when `cull` is on.
@@ -57,7 +59,13 @@ pub(super) fn leaf_intersect<V: Vf32>(
         return false;
     }
     let mut changed = false;
+    let done_before = leaf.near * (1.0 - SPLIT_SLACK);
     for &j in set {
+        // A packet whose rays all hit before the leaf starts: nothing here can be closer.
+        if tile.farthest_hit[j] < done_before {
+            stats.packets_culled += 1;
+            continue;
+        }
         let p = &tile.packets[j];
         let hits = &mut tile.hits[j];
         let active = if cull { overlaps_box(p, bounds, hits.t, SPLIT_SLACK) } else { p.valid };
@@ -66,9 +74,14 @@ pub(super) fn leaf_intersect<V: Vf32>(
             continue;
         }
         stats.packets_tested += 1;
+        let mut packet_changed = false;
         for &id in ids {
             stats.isect_tests += 1;
-            changed |= intersect_packet(p, hits, tree.triangles().get(id), id, active).any();
+            packet_changed |= intersect_packet(p, hits, tree.triangles().get(id), id, active).any();
+        }
+        if packet_changed {
+            tile.farthest_hit[j] = V::select(p.valid, hits.t, V::splat(f32::NEG_INFINITY)).reduce_max();
+            changed = true;
         }
     }
     changed
@@ -115,11 +128,7 @@ pub(super) fn leaf_occlude<V: Vf32>(
 
 /// The largest current hit distance over the lanes of packets `set` (infinite while any lane has none).
 pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> f32 {
-    set.iter().fold(0.0f32, |m, &j| {
-        let p = &tile.packets[j];
-        let t = V::select(p.valid, tile.hits[j].t, V::splat(0.0));
-        m.max(t.reduce_max())
-    })
+    set.iter().fold(0.0f32, |m, &j| m.max(tile.farthest_hit[j]))
 }
 
 impl KdTree {
@@ -198,7 +207,7 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let (limit, stop) = leaf(&Leaf { tree: self, ids: n.leaf_range(), bounds }, stats);
+            let (limit, stop) = leaf(&Leaf { tree: self, ids: n.leaf_range(), bounds, near }, stats);
             if stop {
                 break;
             }

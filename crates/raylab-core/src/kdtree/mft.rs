@@ -91,9 +91,10 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let mut limit = [f32::INFINITY; 4];
-        self.traverse_mft(f, stats, |leaf, active, stats| {
+        self.traverse_mft(f, stats, |tree, ids, bounds, near, active, stats| {
             for (i, set) in sets.iter().enumerate() {
-                if active >> i & 1 == 1 && leaf_intersect(leaf, tile, set, cull, stats) {
+                let leaf = Leaf { tree, ids: ids.clone(), bounds, near: near[i] };
+                if active >> i & 1 == 1 && leaf_intersect(&leaf, tile, set, cull, stats) {
                     limit[i] = hit_limit(tile, set);
                 }
             }
@@ -113,10 +114,11 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let mut done = 0u32;
-        self.traverse_mft(f, stats, |leaf, active, stats| {
+        self.traverse_mft(f, stats, |tree, ids, bounds, near, active, stats| {
             for (i, set) in sets.iter().enumerate() {
                 if active >> i & 1 == 1 {
-                    leaf_occlude(leaf, tile, set, cull, blocked, stats);
+                    let leaf = Leaf { tree, ids: ids.clone(), bounds, near: near[i] };
+                    leaf_occlude(&leaf, tile, set, cull, blocked, stats);
                     if set.iter().all(|&j| (tile.packets[j].valid & !blocked[j]).none()) {
                         done |= 1 << i;
                     }
@@ -126,13 +128,13 @@ impl KdTree {
         });
     }
 
-    /// Walks the leaves the four frustums overlap. `leaf(leaf, active_bits, stats)` returns each lane's
-    /// distance limit and the lanes that are finished.
+    /// Walks the leaves the four frustums overlap. `leaf(tree, ids, box, near_per_lane, active_bits, stats)`
+    /// returns each lane's distance limit and the lanes that are finished.
     fn traverse_mft<V: Vf32>(
         &self,
         f: &Frustum4<V>,
         stats: &mut TraversalStats,
-        mut leaf: impl FnMut(&Leaf, u32, &mut TraversalStats) -> (V, u32),
+        mut leaf: impl FnMut(&KdTree, std::ops::Range<usize>, Aabb, [f32; 4], u32, &mut TraversalStats) -> (V, u32),
     ) {
         if self.triangles().is_empty() || f.valid.none() {
             return;
@@ -177,8 +179,9 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let (limit, finished) =
-                leaf(&Leaf { tree: self, ids: n.leaf_range(), bounds }, (active & !done).bits(), stats);
+            let mut near_lanes = [0.0f32; 4];
+            near.write_to(&mut near_lanes);
+            let (limit, finished) = leaf(self, n.leaf_range(), bounds, near_lanes, (active & !done).bits(), stats);
             done = done | V::Mask::from_bits(finished);
             if (f.valid & !done).none() {
                 break;

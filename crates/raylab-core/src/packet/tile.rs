@@ -14,6 +14,9 @@ pub struct PacketTile<V: Vf32> {
     pub packets: Vec<RayPacket<V>>,
     /// Closest hits (or, for occlusion, the per-lane state) of each packet.
     pub hits: Vec<PacketHits<V>>,
+    /// Per packet, the farthest current hit distance over its rays (infinite while one has none): a leaf
+    /// that starts beyond it cannot improve any of the packet's hits.
+    pub farthest_hit: Vec<f32>,
     /// Index of each packet's lane-0 pixel in the tile, and the tile width, to map lanes back to pixels.
     pub origin_pixel: Vec<(usize, usize)>,
     /// Packet columns and rows.
@@ -47,8 +50,10 @@ impl<V: Vf32> PacketTile<V> {
                 origin_pixel.push((2 * bx, ph * by));
             }
         }
-        let hits = packets.iter().map(PacketHits::new).collect();
-        Self { packets, hits, origin_pixel, cols, rows, width, height }
+        let hits: Vec<PacketHits<V>> = packets.iter().map(PacketHits::new).collect();
+        let farthest_hit =
+            packets.iter().map(|p| V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max()).collect();
+        Self { packets, hits, farthest_hit, origin_pixel, cols, rows, width, height }
     }
 
     /// Calls `f(pixel_index, lane)` for every lane of packet `j` that holds a ray.
