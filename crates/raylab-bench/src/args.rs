@@ -164,7 +164,7 @@ impl KdArgs {
 /// Traversal-method flags shared by `render` and `trace`.
 #[derive(Args, Clone, Debug)]
 pub struct MethodArgs {
-    /// Traversal method: mono, packet, frustum, mft or reference.
+    /// Traversal method: mono, packet, frustum, mft, cone, mft-cone or reference.
     #[arg(long, default_value = "mono")]
     pub method: raylab_core::method::Method,
     /// Tile edge in pixels: the frustum size of frustum methods, the unit threads take for all.

@@ -23,13 +23,18 @@ pub enum Method {
     Frustum,
     /// Multiple Frustum Traversal: four quadrant frustums per tile in SIMD lanes (thesis 4.1.5).
     Mft,
+    /// One cone frustum per tile (thesis 4.1.6-4.1.8, Eq. 4.8, Listings 4.3-4.5).
+    Cone,
+    /// MFT over four cones per tile (thesis 4.1.9, Table 4.5).
+    MftCone,
     /// Every ray against every triangle; for testing only.
     Reference,
 }
 
 impl Method {
     /// All methods, in the order menus list them.
-    pub const ALL: [Method; 5] = [Method::Mono, Method::Packet, Method::Frustum, Method::Mft, Method::Reference];
+    pub const ALL: [Method; 7] =
+        [Method::Mono, Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone, Method::Reference];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -38,18 +43,20 @@ impl Method {
             Method::Packet => "packet",
             Method::Frustum => "frustum",
             Method::Mft => "mft",
+            Method::Cone => "cone",
+            Method::MftCone => "mft-cone",
             Method::Reference => "reference",
         }
     }
 
     /// True for the methods that trace tiles as 2x2 packets (and so need rows of pixels).
     pub fn uses_packets(self) -> bool {
-        matches!(self, Method::Packet | Method::Frustum | Method::Mft)
+        matches!(self, Method::Packet | Method::Frustum | Method::Mft | Method::Cone | Method::MftCone)
     }
 
     /// True for the methods whose cost depends on the tile size (frustums).
     pub fn uses_tiles(self) -> bool {
-        matches!(self, Method::Frustum | Method::Mft)
+        matches!(self, Method::Frustum | Method::Mft | Method::Cone | Method::MftCone)
     }
 }
 

@@ -14,7 +14,7 @@ use raylab_core::workload::{RayKind, WorkloadBuilder};
 use raylab_scene::builtin::{self, Detail};
 use raylab_simd::Backend;
 
-const METHODS: [Method; 3] = [Method::Packet, Method::Frustum, Method::Mft];
+const METHODS: [Method; 5] = [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone];
 const TILES: [usize; 5] = [4, 8, 16, 32, 64];
 
 /// Traces `rays` (a `w x h` image) tile by tile with `tracer`.
@@ -152,7 +152,7 @@ fn rendered_frames_are_identical_for_every_method() {
     let cam = scene.default_view().unwrap().camera;
     let light = scene.lights[0];
     let mut frames = Vec::new();
-    for method in [Method::Mono, Method::Packet, Method::Frustum, Method::Mft] {
+    for method in [Method::Mono, Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone] {
         for tile in [4, 16] {
             let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
             let settings = RenderSettings { width: 61, height: 43, tile, ..Default::default() };

@@ -46,7 +46,7 @@ pub struct CompareArgs {
     #[arg(long, default_value_t = 3, value_parser = in_range(1, 100))]
     builds: u64,
     /// Coherent methods to measure beside Embree's packet and stream APIs (primary and shadow rays).
-    #[arg(long, value_delimiter = ',', default_value = "packet,frustum,mft")]
+    #[arg(long, value_delimiter = ',', default_value = "packet,frustum,mft,cone,mft-cone")]
     methods: Vec<Method>,
     /// Tile sizes for the frustum methods.
     #[arg(long, value_delimiter = ',', default_value = "4,8,16,32,64", value_parser = in_range(2, 256))]

@@ -13,7 +13,7 @@ use raylab_simd::{VMask, Vf32};
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::Aabb;
-use crate::packet::{Frustum, PacketTile, intersect_packet, occlude_packet, overlaps_box};
+use crate::packet::{Bundle, PacketTile, intersect_packet, occlude_packet, overlaps_box};
 use crate::stats::TraversalStats;
 
 #[derive(Clone, Copy)]
@@ -132,11 +132,11 @@ pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> f32 {
 }
 
 impl KdTree {
-    /// Closest hits of the packets `set` of `tile`, whose rays share the origin of frustum `f` and lie
-    /// inside it; results accumulate in `tile.hits`.
-    pub fn intersect_frustum<V: Vf32>(
+    /// Closest hits of the packets `set` of `tile`, whose rays share the origin of bundle `f` (a pyramid
+    /// frustum or a cone) and lie inside it; results accumulate in `tile.hits`.
+    pub fn intersect_frustum<B: Bundle, V: Vf32>(
         &self,
-        f: &Frustum,
+        f: &B,
         tile: &mut PacketTile<V>,
         set: &[usize],
         cull: bool,
@@ -153,9 +153,9 @@ impl KdTree {
 
     /// Marks in `blocked` the lanes of packets `set` that something blocks. The frustum `f` must bound the
     /// rays' segments (it may be built from the other end of the segments, e.g. from a light).
-    pub fn occluded_frustum<V: Vf32>(
+    pub fn occluded_frustum<B: Bundle, V: Vf32>(
         &self,
-        f: &Frustum,
+        f: &B,
         tile: &PacketTile<V>,
         set: &[usize],
         cull: bool,
@@ -171,9 +171,9 @@ impl KdTree {
 
     /// Walks the leaves the frustum overlaps, roughly front to back. `leaf(leaf, stats)` returns the distance
     /// beyond which no ray needs more leaves, and whether the walk can stop.
-    fn traverse_frustum(
+    fn traverse_frustum<B: Bundle>(
         &self,
-        f: &Frustum,
+        f: &B,
         stats: &mut TraversalStats,
         mut leaf: impl FnMut(&Leaf, &mut TraversalStats) -> (f32, bool),
     ) {
@@ -183,7 +183,9 @@ impl KdTree {
         let nodes = self.nodes();
         let mut stack = [Entry { node: 0, near: 0.0, far: 0.0, bounds: Aabb::EMPTY }; STACK];
         let mut sp = 0usize;
-        let (mut node, mut near, mut far, mut bounds) = (0usize, f.t_min, f.t_max, self.bounds());
+        let (t_min, t_max) = f.t_range();
+        let origin = f.origin();
+        let (mut node, mut near, mut far, mut bounds) = (0usize, t_min, t_max, self.bounds());
         let (mut visited, mut leaves) = (0u64, 0u64);
         'walk: loop {
             let n = nodes[node];
@@ -191,7 +193,7 @@ impl KdTree {
             if !n.is_leaf() {
                 let (axis, split) = (n.axis(), n.split());
                 let (lo, hi) = f.crossing(axis, split);
-                let origin_right = split - f.origin[axis] < 0.0;
+                let origin_right = split - origin[axis] < 0.0;
                 let front = n.left() | origin_right as usize;
                 let (left_box, right_box) = child_boxes(&bounds, axis, split);
                 let (front_box, back_box) = if origin_right { (right_box, left_box) } else { (left_box, right_box) };

@@ -13,7 +13,7 @@ use super::frustum::{Leaf, child_boxes, hit_limit, leaf_intersect, leaf_occlude}
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::Aabb;
-use crate::packet::{Frustum, PacketTile};
+use crate::packet::{Bundle4, Frustum, PacketTile};
 use crate::stats::TraversalStats;
 
 /// Four frustums with a common origin, one per SIMD lane.
@@ -54,7 +54,18 @@ impl<V: Vf32> Frustum4<V> {
             valid: V::Mask::from_bits(valid),
         })
     }
+}
 
+impl<V: Vf32> Bundle4<V> for Frustum4<V> {
+    fn origin(&self) -> glam::Vec3 {
+        self.origin
+    }
+    fn t_range(&self) -> (V, V) {
+        (self.t_min, self.t_max)
+    }
+    fn valid(&self) -> V::Mask {
+        self.valid
+    }
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (V, V) {
         let dist = split - self.origin[k];
@@ -82,9 +93,9 @@ const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 
 impl KdTree {
     /// Closest hits of the packets of `tile`; `sets[i]` lists the packets that frustum lane `i` bounds.
-    pub fn intersect_mft<V: Vf32>(
+    pub fn intersect_mft<V: Vf32, F: Bundle4<V>>(
         &self,
-        f: &Frustum4<V>,
+        f: &F,
         tile: &mut PacketTile<V>,
         sets: &[Vec<usize>; 4],
         cull: bool,
@@ -104,9 +115,9 @@ impl KdTree {
 
     /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` lists the packets
     /// that frustum lane `i` bounds.
-    pub fn occluded_mft<V: Vf32>(
+    pub fn occluded_mft<V: Vf32, F: Bundle4<V>>(
         &self,
-        f: &Frustum4<V>,
+        f: &F,
         tile: &PacketTile<V>,
         sets: &[Vec<usize>; 4],
         cull: bool,
@@ -130,13 +141,13 @@ impl KdTree {
 
     /// Walks the leaves the four frustums overlap. `leaf(tree, ids, box, near_per_lane, active_bits, stats)`
     /// returns each lane's distance limit and the lanes that are finished.
-    fn traverse_mft<V: Vf32>(
+    fn traverse_mft<V: Vf32, F: Bundle4<V>>(
         &self,
-        f: &Frustum4<V>,
+        f: &F,
         stats: &mut TraversalStats,
         mut leaf: impl FnMut(&KdTree, std::ops::Range<usize>, Aabb, [f32; 4], u32, &mut TraversalStats) -> (V, u32),
     ) {
-        if self.triangles().is_empty() || f.valid.none() {
+        if self.triangles().is_empty() || f.valid().none() {
             return;
         }
         let lo_slack = V::splat(1.0 - SPLIT_SLACK);
@@ -146,8 +157,10 @@ impl KdTree {
         let mut stack =
             [Entry { node: 0, near: zero, far: zero, active: V::Mask::from_bits(0), bounds: Aabb::EMPTY }; STACK];
         let mut sp = 0usize;
-        let (mut node, mut near, mut far, mut bounds) = (0usize, f.t_min, f.t_max, self.bounds());
-        let mut active = f.valid;
+        let (t_min, t_max) = f.t_range();
+        let origin = f.origin();
+        let (mut node, mut near, mut far, mut bounds) = (0usize, t_min, t_max, self.bounds());
+        let mut active = f.valid();
         let mut done = V::Mask::from_bits(0);
         let (mut visited, mut leaves) = (0u64, 0u64);
         'walk: loop {
@@ -156,7 +169,7 @@ impl KdTree {
             if !n.is_leaf() {
                 let (axis, split) = (n.axis(), n.split());
                 let (lo, hi) = f.crossing(axis, split);
-                let origin_right = split - f.origin[axis] < 0.0;
+                let origin_right = split - origin[axis] < 0.0;
                 let front = n.left() | origin_right as usize;
                 let (left_box, right_box) = child_boxes(&bounds, axis, split);
                 let (front_box, back_box) = if origin_right { (right_box, left_box) } else { (left_box, right_box) };
@@ -183,7 +196,7 @@ impl KdTree {
             near.write_to(&mut near_lanes);
             let (limit, finished) = leaf(self, n.leaf_range(), bounds, near_lanes, (active & !done).bits(), stats);
             done = done | V::Mask::from_bits(finished);
-            if (f.valid & !done).none() {
+            if (f.valid() & !done).none() {
                 break;
             }
             loop {

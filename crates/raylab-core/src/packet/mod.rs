@@ -1,6 +1,7 @@
 //! Ray packets: a few rays in structure-of-arrays form, traced together with SIMD (Tsakok 2008, 2.3.1 and
 //! 4.1.2; Listings 2.5-2.6 show the SoA layout).
 
+mod cone;
 mod tile;
 mod woop;
 
@@ -9,7 +10,8 @@ use raylab_simd::{VMask, Vf32};
 
 use crate::ray::{Hit, Ray};
 
-pub use tile::{Frustum, PacketTile, overlaps_box};
+pub use cone::{Cone, Cone4};
+pub use tile::{Bundle, Bundle4, Frustum, PacketTile, overlaps_box};
 pub use woop::{intersect_packet, occlude_packet};
 
 /// Most lanes a packet may have (8 for AVX).

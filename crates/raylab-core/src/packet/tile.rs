@@ -108,6 +108,48 @@ pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -
     p.valid & (t0 * V::splat(1.0 - slack)).le(t1 * V::splat(1.0 + slack))
 }
 
+/// A bundle of rays from one origin, seen by the frustum walks only through the range of distances at which
+/// its rays cross an axis-aligned plane: pyramid [`Frustum`]s and [`super::Cone`]s implement it.
+pub trait Bundle {
+    /// The common origin.
+    fn origin(&self) -> Vec3;
+    /// The range of distances the walk starts with.
+    fn t_range(&self) -> (f32, f32);
+    /// How far the rays may pass from the origin (see [`Frustum::origin_slack`]).
+    fn origin_slack(&self) -> f32;
+    /// The range of distances at which the bundle crosses the plane `coordinate k = split`; infinite bounds
+    /// mean "some ray never crosses in front of the origin".
+    fn crossing(&self, k: usize, split: f32) -> (f32, f32);
+}
+
+/// Four bundles with one common origin, one per SIMD lane, for Multiple Frustum Traversal.
+pub trait Bundle4<V: Vf32> {
+    /// The common origin.
+    fn origin(&self) -> Vec3;
+    /// Per lane, the range of distances the walk starts with.
+    fn t_range(&self) -> (V, V);
+    /// Lanes that hold a bundle.
+    fn valid(&self) -> V::Mask;
+    /// Per lane, the range of distances at which the bundle crosses `coordinate k = split`.
+    fn crossing(&self, k: usize, split: f32) -> (V, V);
+}
+
+impl Bundle for Frustum {
+    fn origin(&self) -> Vec3 {
+        self.origin
+    }
+    fn t_range(&self) -> (f32, f32) {
+        (self.t_min, self.t_max)
+    }
+    fn origin_slack(&self) -> f32 {
+        self.origin_slack
+    }
+    #[inline(always)]
+    fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
+        Frustum::crossing(self, k, split)
+    }
+}
+
 /// Bounds, for every axis, of the parameters at which the rays of a bundle from one common origin cross an
 /// axis-aligned plane: the interval form of a frustum (thesis 2.3.2 and Listing 4.2, with the omni-directional
 /// changes of 4.1.2). Parameters are each ray's own `t`; an interval `[near, far]` holds every `t` at which

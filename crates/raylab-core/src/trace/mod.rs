@@ -11,6 +11,7 @@ use raylab_simd::{Backend, VMask, Vf32};
 use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
 use crate::method::Method;
+use crate::packet::{Cone, Cone4};
 use crate::packet::{Frustum, PacketTile};
 use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
@@ -129,8 +130,22 @@ impl<'a> Tracer<'a> {
                 Some(f) => self.tree.intersect_frustum(&f, &mut tile, &all, self.options.cull, stats),
                 None => self.packets_intersect(&mut tile, stats),
             },
-            Method::Mft => match self.quadrant_frustums(&tile, rays, None) {
-                Some((f4, sets)) => self.tree.intersect_mft(&f4, &mut tile, &sets, self.options.cull, stats),
+            Method::Mft => match self.quadrants(&tile, rays, None, common_origin_frustum, toward_frustum) {
+                Some((b, sets)) => match Frustum4::new(b) {
+                    Some(f4) => self.tree.intersect_mft(&f4, &mut tile, &sets, self.options.cull, stats),
+                    None => self.packets_intersect(&mut tile, stats),
+                },
+                None => self.packets_intersect(&mut tile, stats),
+            },
+            Method::Cone => match common_origin_cone(&tile, &all) {
+                Some(c) => self.tree.intersect_frustum(&c, &mut tile, &all, self.options.cull, stats),
+                None => self.packets_intersect(&mut tile, stats),
+            },
+            Method::MftCone => match self.quadrants(&tile, rays, None, common_origin_cone, toward_cone) {
+                Some((b, sets)) => match Cone4::new(b) {
+                    Some(c4) => self.tree.intersect_mft(&c4, &mut tile, &sets, self.options.cull, stats),
+                    None => self.packets_intersect(&mut tile, stats),
+                },
                 None => self.packets_intersect(&mut tile, stats),
             },
             _ => self.packets_intersect(&mut tile, stats),
@@ -165,9 +180,17 @@ impl<'a> Tracer<'a> {
             Method::Frustum => frustum().map(|f| {
                 self.tree.occluded_frustum(&f, &tile, &all, self.options.cull, &mut blocked, stats);
             }),
-            Method::Mft => self.quadrant_frustums(&tile, rays, toward).map(|(f4, sets)| {
-                self.tree.occluded_mft(&f4, &tile, &sets, self.options.cull, &mut blocked, stats);
-            }),
+            Method::Mft => self
+                .quadrants(&tile, rays, toward, common_origin_frustum, toward_frustum)
+                .and_then(|(b, sets)| Some((Frustum4::new(b)?, sets)))
+                .map(|(f4, sets)| self.tree.occluded_mft(&f4, &tile, &sets, self.options.cull, &mut blocked, stats)),
+            Method::Cone => common_origin_cone(&tile, &all)
+                .or_else(|| toward.and_then(|t| toward_cone(rays, t)))
+                .map(|c| self.tree.occluded_frustum(&c, &tile, &all, self.options.cull, &mut blocked, stats)),
+            Method::MftCone => self
+                .quadrants(&tile, rays, toward, common_origin_cone, toward_cone)
+                .and_then(|(b, sets)| Some((Cone4::new(b)?, sets)))
+                .map(|(c4, sets)| self.tree.occluded_mft(&c4, &tile, &sets, self.options.cull, &mut blocked, stats)),
             _ => None,
         };
         if traced.is_none() {
@@ -181,19 +204,23 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// The four quadrant frustums of a tile (in whole packets) and the packets each bounds.
-    fn quadrant_frustums<V: Vf32>(
+    /// The four quadrant bundles of a tile (in whole packets) and the packets each bounds; `common` builds a
+    /// bundle from packets with one origin, `toward` one from segments that end at a light.
+    fn quadrants<V: Vf32, B: Copy>(
         &self,
         tile: &PacketTile<V>,
         rays: &[Option<Ray>],
         toward: Option<Vec3>,
-    ) -> Option<(Frustum4<V>, [Vec<usize>; 4])> {
+        common: fn(&PacketTile<V>, &[usize]) -> Option<B>,
+        toward_fn: fn(&[Option<Ray>], Vec3) -> Option<B>,
+    ) -> Option<Quadrants<B>> {
         let ph = PacketTile::<V>::PACKET_H;
         let (cx, cy) = (tile.cols.div_ceil(2) * 2, tile.rows.div_ceil(2) * ph);
         let (w, h) = (tile.width, tile.height);
         let quads = [(0, 0, cx.min(w), cy.min(h)), (cx, 0, w, cy.min(h)), (0, cy, cx.min(w), h), (cx, cy, w, h)];
         let mut sets: [Vec<usize>; 4] = Default::default();
-        let mut frustums = [None; 4];
+        let mut bundles = [None; 4];
+        let mut origin = None;
         for (i, &(x0, y0, x1, y1)) in quads.iter().enumerate() {
             if x0 >= x1 || y0 >= y1 {
                 continue;
@@ -202,28 +229,28 @@ impl<'a> Tracer<'a> {
             if set.iter().all(|&j| tile.packets[j].valid.none()) {
                 continue;
             }
-            let f = match common_origin_frustum(tile, &set) {
-                Some(f) => f,
+            let (b, o) = match common_origin(tile, &set) {
+                Some(o) => (common(tile, &set)?, o),
                 None => {
+                    let t = toward?;
                     let sub: Vec<Option<Ray>> =
                         (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| rays[y * w + x]).collect();
-                    toward_frustum(&sub, toward?)?
+                    (toward_fn(&sub, t)?, t)
                 }
             };
-            frustums[i] = Some(f);
+            // All four must share one origin.
+            if *origin.get_or_insert(o) != o {
+                return None;
+            }
+            bundles[i] = Some(b);
             sets[i] = set;
         }
-        // All four must share one origin.
-        let first = frustums.iter().flatten().next()?.origin;
-        if frustums.iter().flatten().any(|f| f.origin != first) {
-            return None;
-        }
-        Some((Frustum4::new(frustums)?, sets))
+        Some((bundles, sets))
     }
 }
 
-/// The frustum of the packets `set` of `tile` when all their rays start at one point, else `None`.
-fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Frustum> {
+/// The origin shared by every valid ray of packets `set`, if there is one.
+fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Vec3> {
     let origin = set
         .iter()
         .find_map(|&j| {
@@ -238,15 +265,39 @@ fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option
         let at_origin = p.org[0].eq(o[0]) & p.org[1].eq(o[1]) & p.org[2].eq(o[2]);
         (p.valid & !at_origin).none()
     });
-    if !same {
-        return None;
-    }
-    Frustum::from_packets(origin, &tile.packets, set)
+    same.then_some(origin)
 }
 
-/// The frustum, seen from `toward`, of segments that end there (shadow rays to a light): the thesis traces
-/// shadow rays from the light toward the surface points. `None` when some segment does not end near it.
-fn toward_frustum(rays: &[Option<Ray>], toward: Vec3) -> Option<Frustum> {
+/// The cone of packets `set` when all their rays start at one point, else `None`.
+fn common_origin_cone<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Cone> {
+    Cone::from_packets(common_origin(tile, set)?, &tile.packets, set)
+}
+
+/// The cone, seen from `toward`, of segments that end there (shadow rays to a light), like
+/// [`toward_frustum`].
+fn toward_cone(rays: &[Option<Ray>], toward: Vec3) -> Option<Cone> {
+    let (segs, slack) = toward_segments(rays, toward)?;
+    let mut c = Cone::bounding(toward, segs.iter().copied())?;
+    let scale = toward.abs().max_element() + c.t_max;
+    c.origin_slack = slack * 2.0 + scale * 4.0 * f32::EPSILON;
+    c.t_max = c.t_max * (1.0 + 4.0 * f32::EPSILON) + c.origin_slack;
+    Some(c)
+}
+
+/// The frustum of the packets `set` of `tile` when all their rays start at one point, else `None`.
+fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Frustum> {
+    Frustum::from_packets(common_origin(tile, set)?, &tile.packets, set)
+}
+
+/// A tile's four quadrant bundles (empty quadrants are `None`) and the packets each bounds.
+type Quadrants<B> = ([Option<B>; 4], [Vec<usize>; 4]);
+
+/// A segment seen from a light: unit direction, start and end distance.
+type Segment = (Vec3, f32, f32);
+
+/// The segments of `rays` seen from `toward`, and how far their ends miss it; `None` when some segment does
+/// not end near it.
+fn toward_segments(rays: &[Option<Ray>], toward: Vec3) -> Option<(Vec<Segment>, f32)> {
     let mut slack = 0.0f32;
     let mut segs = Vec::new();
     for r in rays.iter().flatten().filter(|r| r.is_valid()) {
@@ -264,6 +315,13 @@ fn toward_frustum(rays: &[Option<Ray>], toward: Vec3) -> Option<Frustum> {
         slack = slack.max(gap);
         segs.push((v / len, 0.0, len));
     }
+    Some((segs, slack))
+}
+
+/// The frustum, seen from `toward`, of segments that end there (shadow rays to a light): the thesis traces
+/// shadow rays from the light toward the surface points. `None` when some segment does not end near it.
+fn toward_frustum(rays: &[Option<Ray>], toward: Vec3) -> Option<Frustum> {
+    let (segs, slack) = toward_segments(rays, toward)?;
     let mut f = Frustum::bounding(toward, segs)?;
     // Cover the rounding of the segments' ends and of the positions themselves.
     let scale = toward.abs().max_element() + f.t_max;

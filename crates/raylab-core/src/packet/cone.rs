@@ -1,0 +1,216 @@
+//! Cone frustums (Tsakok 2008, 4.1.6-4.1.8, Eq. 4.8, Listings 4.3-4.5): a bundle bounded by a cone with apex
+//! at the common origin, axis `v` and half-angle `alpha`.
+//!
+//! Distances along a cone are depths along its axis. A ray at angle `theta <= alpha` from `v` has
+//! `u_k / cos(theta) = v_k + tan(theta) w_k` with `|w_k| <= sqrt(1 - v_k^2)`, so at depth `tau` its
+//! coordinate on axis `k` is `s_k + tau (v_k + tan(theta) w_k)`. Every ray of the cone therefore crosses the
+//! plane `x_k = split` at a depth between `dist / (v_k + beta_k)` and `dist / (v_k - beta_k)`, where
+//! `dist = split - s_k` and `beta_k = tan(alpha) sqrt(1 - v_k^2)` (Eq. 4.8). The two reciprocals are
+//! precomputed per axis (Listing 4.4), so a split costs two multiplies; a negative depth means "never
+//! crosses in front" and becomes infinite (the omni-directional rule of 4.1.2).
+//!
+//! Depth is at most the distance along a unit direction, so comparing an entry's depth with the rays' hit
+//! distances stays conservative.
+
+use glam::Vec3;
+use raylab_simd::{VMask, Vf32};
+
+use super::{RayPacket, tile::Bundle, tile::Bundle4};
+
+/// A cone bounding a bundle of rays from one origin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    /// Apex: the common origin.
+    pub origin: Vec3,
+    /// Unit axis.
+    pub axis: Vec3,
+    /// Tangent of the half-angle.
+    pub tan_alpha: f32,
+    /// Per axis `1 / (v_k + beta_k)` (Listing 4.4's `precompute[0]`).
+    pub inv_hi: [f32; 3],
+    /// Per axis `1 / (v_k - beta_k)` (`precompute[1]`).
+    pub inv_lo: [f32; 3],
+    /// Smallest start depth.
+    pub t_min: f32,
+    /// Largest end distance (a bound on depth).
+    pub t_max: f32,
+    /// As [`super::Frustum::origin_slack`].
+    pub origin_slack: f32,
+}
+
+impl Cone {
+    /// The narrowest cone about the mean direction that holds unit directions `dirs` with start and end
+    /// distances; `None` when the bundle is empty or spans more than a hemisphere.
+    pub fn bounding(origin: Vec3, segments: impl Iterator<Item = (Vec3, f32, f32)> + Clone) -> Option<Self> {
+        let axis = segments.clone().fold(Vec3::ZERO, |s, (d, _, _)| s + d).normalize_or_zero();
+        if axis == Vec3::ZERO {
+            return None;
+        }
+        // The half-angle from |d x axis| / (d . axis) in double precision: 1 - cos^2 would cancel for the
+        // nearly parallel rays of small tiles and give too narrow a cone.
+        let a = axis.as_dvec3();
+        let (mut tan_max, mut t_min, mut t_max) = (0.0f64, f32::INFINITY, f32::NEG_INFINITY);
+        for (d, t0, t1) in segments {
+            let d = d.as_dvec3();
+            let c = d.dot(a);
+            if c <= 0.05 * d.length() || c.is_nan() {
+                return None;
+            }
+            tan_max = tan_max.max(d.cross(a).length() / c);
+            t_min = t_min.min(t0);
+            t_max = t_max.max(t1);
+        }
+        // Pad for the rounding of the unit directions and of the later f32 products.
+        let tan_alpha = (tan_max * (1.0 + 1e-4) + 1e-5) as f32;
+        let beta = axis.to_array().map(|v| tan_alpha * (1.0 - v * v).max(0.0).sqrt());
+        let v = axis.to_array();
+        Some(Self {
+            origin,
+            axis,
+            tan_alpha,
+            inv_hi: std::array::from_fn(|k| 1.0 / (v[k] + beta[k])),
+            inv_lo: std::array::from_fn(|k| 1.0 / (v[k] - beta[k])),
+            t_min: t_min.max(0.0),
+            t_max,
+            origin_slack: 0.0,
+        })
+    }
+
+    /// The cone of the valid rays of `packets[set]`, which all start at `origin`.
+    pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>], set: &[usize]) -> Option<Self> {
+        let segs = set.iter().flat_map(|&j| {
+            let p = &packets[j];
+            let bits = p.valid.bits();
+            (0..V::LANES).filter(move |i| bits >> i & 1 == 1).map(move |i| {
+                let r = p.ray(i);
+                let len = r.dir.length();
+                (r.dir / len, r.tmin * len, r.tmax * len)
+            })
+        });
+        Self::bounding(origin, segs)
+    }
+}
+
+impl Bundle for Cone {
+    fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    fn t_range(&self) -> (f32, f32) {
+        (self.t_min, self.t_max)
+    }
+
+    fn origin_slack(&self) -> f32 {
+        self.origin_slack
+    }
+
+    /// Listing 4.3 with the omni-directional rule: the two edge depths, negative ones made infinite, sorted.
+    #[inline(always)]
+    fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
+        let dist = split - self.origin[k];
+        let slack = self.origin_slack;
+        if dist.abs() <= slack {
+            return (0.0, f32::INFINITY);
+        }
+        let (near_d, far_d) = if dist > 0.0 { (dist - slack, dist + slack) } else { (dist + slack, dist - slack) };
+        let fix = |t: f32| if t < 0.0 || t.is_nan() { f32::INFINITY } else { t };
+        let (a, b) = (fix(near_d * self.inv_hi[k]), fix(near_d * self.inv_lo[k]));
+        let (c, d) = (fix(far_d * self.inv_hi[k]), fix(far_d * self.inv_lo[k]));
+        (a.min(b).min(c.min(d)), a.max(b).max(c.max(d)))
+    }
+}
+
+/// Four cones with one apex, one per SIMD lane (MFT over cones, thesis 4.1.9).
+#[derive(Clone, Copy, Debug)]
+pub struct Cone4<V: Vf32> {
+    origin: Vec3,
+    inv_hi: [V; 3],
+    inv_lo: [V; 3],
+    t_min: V,
+    t_max: V,
+    origin_slack: f32,
+    valid: V::Mask,
+}
+
+impl<V: Vf32> Cone4<V> {
+    /// Packs up to four cones with the same apex; `None` entries leave a lane empty.
+    pub fn new(c: [Option<Cone>; 4]) -> Option<Self> {
+        assert_eq!(V::LANES, 4, "MFT traces four cones");
+        let origin = c.iter().flatten().next()?.origin;
+        assert!(c.iter().flatten().all(|x| x.origin == origin), "MFT cones share their apex");
+        let lanes = |g: &dyn Fn(&Cone) -> f32, empty: f32| V::from_slice(&c.map(|x| x.as_ref().map_or(empty, g)));
+        let valid = c.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
+        Some(Self {
+            origin,
+            inv_hi: [0, 1, 2].map(|k| lanes(&|x: &Cone| x.inv_hi[k], 0.0)),
+            inv_lo: [0, 1, 2].map(|k| lanes(&|x: &Cone| x.inv_lo[k], 0.0)),
+            t_min: lanes(&|x| x.t_min, f32::INFINITY),
+            t_max: lanes(&|x| x.t_max, f32::NEG_INFINITY),
+            origin_slack: c.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack)),
+            valid: V::Mask::from_bits(valid),
+        })
+    }
+}
+
+impl<V: Vf32> Bundle4<V> for Cone4<V> {
+    fn origin(&self) -> Vec3 {
+        self.origin
+    }
+    fn t_range(&self) -> (V, V) {
+        (self.t_min, self.t_max)
+    }
+    fn valid(&self) -> V::Mask {
+        self.valid
+    }
+    #[inline(always)]
+    fn crossing(&self, k: usize, split: f32) -> (V, V) {
+        let dist = split - self.origin[k];
+        let slack = self.origin_slack;
+        if dist.abs() <= slack {
+            return (V::splat(0.0), V::splat(f32::INFINITY));
+        }
+        let (near_d, far_d) = if dist > 0.0 { (dist - slack, dist + slack) } else { (dist + slack, dist - slack) };
+        let inf = V::splat(f32::INFINITY);
+        let zero = V::splat(0.0);
+        // Negative (or NaN) depths never come: make them infinite, as in Listing 4.5.
+        let fix = |t: V| V::select(t.ge(zero), t, inf);
+        let (a, b) = (fix(V::splat(near_d) * self.inv_hi[k]), fix(V::splat(near_d) * self.inv_lo[k]));
+        let (c, d) = (fix(V::splat(far_d) * self.inv_hi[k]), fix(V::splat(far_d) * self.inv_lo[k]));
+        (a.min(b).min(c.min(d)), a.max(b).max(c.max(d)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cone_crossing_bounds_every_ray() {
+        let o = Vec3::new(1.0, 2.0, -0.5);
+        let dirs = [
+            Vec3::new(1.0, 0.1, 0.05),
+            Vec3::new(0.9, -0.1, 0.0),
+            Vec3::new(1.0, 0.0, -0.12),
+            Vec3::new(0.95, 0.08, 0.1),
+        ]
+        .map(|d| d.normalize());
+        let c = Cone::bounding(o, dirs.iter().map(|&d| (d, 0.0, f32::INFINITY))).unwrap();
+        for k in 0..3 {
+            for split in [-4.0f32, -0.6, 0.0, 1.5, 2.5, 9.0] {
+                let (lo, hi) = c.crossing(k, split);
+                assert!(lo <= hi);
+                for d in dirs {
+                    let t = (split - o[k]) / d[k];
+                    if t > 0.0 && t.is_finite() {
+                        let depth = t * d.dot(c.axis);
+                        assert!(
+                            depth >= lo * (1.0 - 1e-5) && depth <= hi * (1.0 + 1e-5),
+                            "axis {k} split {split}: {depth} not in [{lo}, {hi}]"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(Cone::bounding(o, [(Vec3::X, 0.0, 1.0), (Vec3::NEG_X, 0.0, 1.0)].into_iter()).is_none());
+    }
+}
