@@ -67,6 +67,11 @@ pub struct SceneArgs {
 }
 
 impl SceneArgs {
+    /// The scene `name` with its own default view and light.
+    pub fn named(name: &str) -> Self {
+        Self { scene: name.to_string(), view: None, eye: None, target: None, up: None, fov: None, light: None }
+    }
+
     /// Where the scene comes from.
     pub fn source(&self) -> SceneSource {
         SceneSource::parse(&self.scene)

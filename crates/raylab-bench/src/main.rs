@@ -27,6 +27,8 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Run the Embree harness and raylab on the same view in one go, and print the comparison table.
     Compare(commands::compare::CompareArgs),
+    /// Regenerate the thesis's Tables 4.1-4.5 (FPS, N, I per method and tile) for the built-in scenes.
+    Tables(commands::tables::TablesArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -37,6 +39,7 @@ fn main() -> std::process::ExitCode {
         Some(Command::Trace(a)) => commands::trace::run(a),
         Some(Command::Info(a)) => commands::info::run(a),
         Some(Command::Compare(a)) => commands::compare::run(a),
+        Some(Command::Tables(a)) => commands::tables::run(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

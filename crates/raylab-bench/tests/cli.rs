@@ -89,3 +89,34 @@ fn bad_input_is_refused_with_a_clear_error() {
         assert!(!e.contains("panicked"), "{args:?} panicked: {e}");
     }
 }
+
+#[test]
+fn tables_print_the_thesis_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tables.md");
+    let o = bench(
+        &[
+            "tables",
+            "--builtins",
+            "arena",
+            "--scene",
+            "arena",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--reps",
+            "1",
+            "--threads",
+            "1",
+            "--markdown",
+            out.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = std::fs::read_to_string(&out).unwrap();
+    for t in ["Table 4.1", "Table 4.2", "Table 4.3", "Table 4.4", "Table 4.5", "| arena |"] {
+        assert!(md.contains(t), "missing {t} in:\n{md}");
+    }
+}

@@ -1,0 +1,252 @@
+//! `raylab-bench tables`: the thesis's Tables 4.1-4.5 (Tsakok 2008, chapter 4) regenerated for the built-in
+//! scenes (and one OBJ given with `--scene`): frame rate at 512x512 with the simple benchmark shading, N
+//! (nodes per 2x2 packet) and I (triangle tests per packet) for 2x2 packets, single frustums, MFT, cones and
+//! MFT over cones, the effect of packet/leaf culling, and percentage changes against the single frustum.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use raylab_core::method::Method;
+use raylab_core::render::{RenderSettings, render};
+use raylab_core::scene::{Camera, PointLight, Scene};
+use raylab_core::stats::TraversalStats;
+use raylab_core::trace::{TraceOptions, Tracer};
+
+use crate::args::{KdArgs, SceneArgs, in_range};
+use crate::env::Environment;
+use crate::prepare::{build_tree, load_scene};
+
+/// Regenerates thesis Tables 4.1-4.5 for the built-in scenes and the scene given with `--scene` (for
+/// instance the shared Sponza with its benchmark view).
+#[derive(Args, Debug)]
+pub struct TablesArgs {
+    /// Built-in scenes to measure, each from its default view.
+    #[arg(long, value_delimiter = ',', default_value = "arena,kitchen,atrium,forest")]
+    builtins: Vec<String>,
+    /// One more scene (a built-in name not listed above, or an OBJ path) with the camera and light flags.
+    #[command(flatten)]
+    view: SceneArgs,
+    #[command(flatten)]
+    kd: KdArgs,
+    /// Image width.
+    #[arg(long, default_value_t = 512, value_parser = in_range(16, 4096))]
+    width: u64,
+    /// Image height.
+    #[arg(long, default_value_t = 512, value_parser = in_range(16, 4096))]
+    height: u64,
+    /// Rendering threads (the thesis used 2 cores).
+    #[arg(long, default_value_t = 2, value_parser = in_range(1, 1024))]
+    threads: u64,
+    /// Timed frames per configuration (the median frame time gives the FPS).
+    #[arg(long, default_value_t = 5, value_parser = in_range(1, 1000))]
+    reps: u64,
+    /// Also write the markdown to this file.
+    #[arg(long)]
+    markdown: Option<PathBuf>,
+}
+
+/// One measured configuration.
+#[derive(Clone, Copy)]
+struct Cell {
+    fps: f64,
+    n: f64,
+    i: f64,
+    culled: f64,
+}
+
+fn measure(
+    scene: &Scene,
+    tracer: &Tracer,
+    cam: &Camera,
+    light: PointLight,
+    s: &RenderSettings,
+    pool: &rayon::ThreadPool,
+    reps: u64,
+) -> Cell {
+    let mut times = Vec::new();
+    let mut stats = TraversalStats::default();
+    pool.install(|| {
+        render(scene, tracer, cam, light, s);
+        for _ in 0..reps {
+            let t0 = Instant::now();
+            let f = render(scene, tracer, cam, light, s);
+            times.push(t0.elapsed().as_secs_f64());
+            stats = f.stats;
+        }
+    });
+    times.sort_by(f64::total_cmp);
+    let tested = stats.packets_culled + stats.packets_tested;
+    Cell {
+        fps: 1.0 / times[times.len() / 2],
+        n: stats.nodes_per_packet(),
+        i: stats.isects_per_packet(),
+        culled: if tested == 0 { 0.0 } else { 100.0 * stats.packets_culled as f64 / tested as f64 },
+    }
+}
+
+fn pct(a: f64, b: f64) -> String {
+    format!("{:+.1}%", 100.0 * (a - b) / b)
+}
+
+/// Runs the command.
+pub fn run(a: &TablesArgs) -> Result<(), String> {
+    let env = Environment::detect();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string())?;
+    let mut scenes: Vec<(String, Scene, Camera, PointLight)> = Vec::new();
+    for name in &a.builtins {
+        let args = SceneArgs::named(name);
+        let (scene, _) = load_scene(&args.source())?;
+        let (cam, light) = args.camera_and_light(&scene)?;
+        scenes.push((name.clone(), scene, cam, light));
+    }
+    if !a.builtins.contains(&a.view.scene) {
+        let (scene, _) = load_scene(&a.view.source())?;
+        let (cam, light) = a.view.camera_and_light(&scene)?;
+        let s = &a.view.scene;
+        let name = std::path::Path::new(s).file_stem().map_or(s.clone(), |x| x.to_string_lossy().into_owned());
+        scenes.push((name, scene, cam, light));
+    }
+    let tiles = [4u32, 8, 16, 32];
+    let settings = |tile: u32| RenderSettings {
+        width: a.width as u32,
+        height: a.height as u32,
+        tile,
+        shadows: false,
+        ..Default::default()
+    };
+    let params = a.kd.params()?;
+    // Per scene: packet, frustum[tiles], frustum 8 without culling, mft[tiles], cone[3], mft-cone[3].
+    struct Row {
+        name: String,
+        packet: Cell,
+        frustum: Vec<Cell>,
+        nocull8: Cell,
+        mft: Vec<Cell>,
+        cone: Vec<Cell>,
+        mft_cone: Vec<Cell>,
+    }
+    let mut rows = Vec::new();
+    for (name, scene, cam, light) in &scenes {
+        let tree = build_tree(scene, &params, a.threads as usize)?;
+        let tracer = |method, cull| Tracer::new(&tree, None, TraceOptions { method, cull, ..Default::default() });
+        let m = |method: Method, tile: u32, cull: bool| {
+            measure(scene, &tracer(method, cull), cam, *light, &settings(tile), &pool, a.reps)
+        };
+        eprintln!("measuring {name} ({} triangles)", scene.triangle_count());
+        rows.push(Row {
+            name: name.clone(),
+            packet: m(Method::Packet, 16, true),
+            frustum: tiles.iter().map(|&t| m(Method::Frustum, t, true)).collect(),
+            nocull8: m(Method::Frustum, 8, false),
+            mft: tiles.iter().map(|&t| m(Method::Mft, t, true)).collect(),
+            cone: tiles[..3].iter().map(|&t| m(Method::Cone, t, true)).collect(),
+            mft_cone: tiles[..3].iter().map(|&t| m(Method::MftCone, t, true)).collect(),
+        });
+    }
+
+    let mut md = String::new();
+    let cmd: Vec<String> = std::env::args().collect();
+    let _ = writeln!(md, "Machine and build: {}.", env.line());
+    let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
+    let _ = writeln!(
+        md,
+        "\n{}x{}, {} threads, primary rays with the simple shading (one point light, N.L, attenuation), no \
+         shadows; FPS from the median of {} frames.",
+        a.width, a.height, a.threads, a.reps
+    );
+    let cells = |c: &Cell| format!("{:.1} | {:.2} | {:.2}", c.fps, c.n, c.i);
+    let _ = writeln!(md, "\n**Table 4.1**: 2x2 packets and single frustums (FPS, N, I).\n");
+    let _ = write!(md, "| scene | packet 2x2 FPS | N | I |");
+    for t in tiles {
+        let _ = write!(md, " frustum {t}x{t} FPS | N | I |");
+    }
+    let _ = writeln!(md, "\n|---|{}", "---:|".repeat(3 + 3 * tiles.len()));
+    for r in &rows {
+        let _ = write!(md, "| {} | {} |", r.name, cells(&r.packet));
+        for c in &r.frustum {
+            let _ = write!(md, " {} |", cells(c));
+        }
+        let _ = writeln!(md);
+    }
+    let _ = writeln!(md, "\n**Table 4.2**: packet/leaf culling, frustum 8x8.\n");
+    let _ = writeln!(md, "| scene | FPS with culling | FPS without | frame-rate change | packet/leaf visits culled |");
+    let _ = writeln!(md, "|---|---:|---:|---:|---:|");
+    for r in &rows {
+        let (on, off) = (r.frustum[1], r.nocull8);
+        let _ = writeln!(
+            md,
+            "| {} | {:.1} | {:.1} | {} | {:.1}% |",
+            r.name,
+            on.fps,
+            off.fps,
+            pct(on.fps, off.fps),
+            on.culled
+        );
+    }
+    let _ = writeln!(md, "\n**Table 4.3**: MFT (FPS, N, I and change against the single frustum at the same tile).\n");
+    let _ = writeln!(md, "| scene | tile | FPS | N | I | % FPS | % N | % I |");
+    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|");
+    for r in &rows {
+        for (k, t) in tiles.iter().enumerate() {
+            let (m, f) = (r.mft[k], r.frustum[k]);
+            let _ = writeln!(
+                md,
+                "| {} | {t}x{t} | {} | {} | {} | {} |",
+                r.name,
+                cells(&m),
+                pct(m.fps, f.fps),
+                pct(m.n, f.n),
+                pct(m.i, f.i)
+            );
+        }
+    }
+    let _ = writeln!(md, "\n**Table 4.4**: peak frame rates.\n");
+    let _ = writeln!(md, "| scene | MFT FPS | MFT tile | non-MFT FPS | non-MFT method and tile | MFT / non-MFT |");
+    let _ = writeln!(md, "|---|---:|---:|---:|---|---:|");
+    for r in &rows {
+        let (bi, bm) = r.mft.iter().enumerate().max_by(|x, y| x.1.fps.total_cmp(&y.1.fps)).expect("tiles");
+        let mut best = (r.packet.fps, "packet 2x2".to_string());
+        for (k, f) in r.frustum.iter().enumerate() {
+            if f.fps > best.0 {
+                best = (f.fps, format!("frustum {0}x{0}", tiles[k]));
+            }
+        }
+        let _ = writeln!(
+            md,
+            "| {} | {:.1} | {t}x{t} | {:.1} | {} | {:.2}x |",
+            r.name,
+            bm.fps,
+            best.0,
+            best.1,
+            bm.fps / best.0,
+            t = tiles[bi]
+        );
+    }
+    let _ = writeln!(md, "\n**Table 4.5**: cones (single cone and MFT over four cones) against the single frustum.\n");
+    let _ = writeln!(md, "| scene | method | tile | FPS | N | I | % FPS | % N | % I |");
+    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    for r in &rows {
+        for (label, v) in [("cone", &r.cone), ("MFT cone", &r.mft_cone)] {
+            for (k, c) in v.iter().enumerate() {
+                let f = r.frustum[k];
+                let t = tiles[k];
+                let _ = writeln!(
+                    md,
+                    "| {} | {label} | {t}x{t} | {} | {} | {} | {} |",
+                    r.name,
+                    cells(c),
+                    pct(c.fps, f.fps),
+                    pct(c.n, f.n),
+                    pct(c.i, f.i)
+                );
+            }
+        }
+    }
+    print!("{md}");
+    if let Some(p) = &a.markdown {
+        std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Regenerates the thesis-tables section of docs/BENCHMARKS.md: Tables 4.1-4.5 (FPS, N, I per method and tile)
+# for the built-in scenes and the shared Sponza view, with `raylab-bench tables`. Run it on a committed tree.
+#
+#   scripts/thesis-tables.sh            # 512x512, 2 threads, median of 5 frames
+#   REPS=3 scripts/thesis-tables.sh
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+reps=${REPS:-5}
+cargo build --release -p raylab-bench --manifest-path "$root/Cargo.toml"
+
+cd "$root"
+table=$(mktemp)
+target/release/raylab-bench tables --scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 \
+  --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0 --threads 2 --reps "$reps" --markdown "$table"
+
+awk -v table="$table" '
+  /<!-- thesis-tables:begin -->/ { print; while ((getline line < table) > 0) print line; skip = 1; next }
+  /<!-- thesis-tables:end -->/ { skip = 0 }
+  !skip { print }
+' docs/BENCHMARKS.md > docs/BENCHMARKS.md.new
+mv docs/BENCHMARKS.md.new docs/BENCHMARKS.md
+rm -f "$table"
+echo "updated docs/BENCHMARKS.md"
