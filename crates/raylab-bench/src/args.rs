@@ -181,6 +181,16 @@ pub struct MethodArgs {
     /// SIMD backend of packet kernels: sse2 (x86-64) or scalar.
     #[arg(long, value_parser = parse_backend)]
     pub backend: Option<raylab_simd::Backend>,
+    /// Widest shadow bundle seen from the light (tangent of its half-angle) that frustum methods trace as a
+    /// frustum; wider ones go as 2x2 packets. 0 traces all shadow rays as packets.
+    #[arg(long, default_value_t = raylab_core::trace::TraceOptions::SHADOW_SPREAD_LIMIT, value_parser = parse_spread)]
+    pub shadow_spread_limit: f32,
+}
+
+/// Parses a non-negative finite spread limit.
+fn parse_spread(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(format!("{v} must be finite and >= 0")) }
 }
 
 impl MethodArgs {
@@ -190,6 +200,7 @@ impl MethodArgs {
             method: self.method,
             cull: !self.no_cull,
             backend: self.backend.unwrap_or_else(raylab_simd::Backend::detect),
+            shadow_spread_limit: self.shadow_spread_limit,
         }
     }
 }

@@ -71,9 +71,12 @@ fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what
     let (_, want_occ) = trace_image(&mono, &shadow, w, h, 8, Some(light));
     for method in METHODS {
         for backend in Backend::available() {
-            for cull in [true, false] {
+            for (cull, spread) in
+                [(true, TraceOptions::SHADOW_SPREAD_LIMIT), (false, f32::INFINITY), (true, f32::INFINITY)]
+            {
                 for tile in TILES {
-                    let opts = TraceOptions { method, cull, backend };
+                    // An infinite spread limit sends every shadow tile down the frustum path.
+                    let opts = TraceOptions { method, cull, backend, shadow_spread_limit: spread };
                     let tracer = Tracer::new(&tree, None, opts);
                     let (hits, _) = trace_image(&tracer, &primary, w, h, tile, None);
                     let (_, occ) = trace_image(&tracer, &shadow, w, h, tile, Some(light));

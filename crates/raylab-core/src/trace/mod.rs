@@ -26,11 +26,25 @@ pub struct TraceOptions {
     pub cull: bool,
     /// SIMD backend of the packet kernels.
     pub backend: Backend,
+    /// Widest shadow bundle (tangent of the largest angle between a ray and the bundle's mean direction, seen
+    /// from the light) that the frustum methods trace as a frustum; wider tiles or quadrants, whose hit points
+    /// are spread in depth, are traced as 2x2 packets instead, which is faster for them.
+    pub shadow_spread_limit: f32,
+}
+
+impl TraceOptions {
+    /// Default of [`TraceOptions::shadow_spread_limit`], chosen with `raylab-bench compare` on the Sponza view.
+    pub const SHADOW_SPREAD_LIMIT: f32 = 0.05;
 }
 
 impl Default for TraceOptions {
     fn default() -> Self {
-        Self { method: Method::Mono, cull: true, backend: Backend::detect() }
+        Self {
+            method: Method::Mono,
+            cull: true,
+            backend: Backend::detect(),
+            shadow_spread_limit: Self::SHADOW_SPREAD_LIMIT,
+        }
     }
 }
 
@@ -131,7 +145,7 @@ impl<'a> Tracer<'a> {
                 None => self.packets_intersect(&mut tile, stats),
             },
             Method::Mft => match self.quadrants(&tile, rays, None, common_origin_frustum, toward_frustum) {
-                Some((b, sets)) => match Frustum4::new(b) {
+                Some((b, sets, _)) => match Frustum4::new(b) {
                     Some(f4) => self.tree.intersect_mft(&f4, &mut tile, &sets, self.options.cull, stats),
                     None => self.packets_intersect(&mut tile, stats),
                 },
@@ -142,7 +156,7 @@ impl<'a> Tracer<'a> {
                 None => self.packets_intersect(&mut tile, stats),
             },
             Method::MftCone => match self.quadrants(&tile, rays, None, common_origin_cone, toward_cone) {
-                Some((b, sets)) => match Cone4::new(b) {
+                Some((b, sets, _)) => match Cone4::new(b) {
                     Some(c4) => self.tree.intersect_mft(&c4, &mut tile, &sets, self.options.cull, stats),
                     None => self.packets_intersect(&mut tile, stats),
                 },
@@ -175,28 +189,45 @@ impl<'a> Tracer<'a> {
         let all: Vec<usize> = (0..tile.packets.len()).collect();
         stats.rays += rays.iter().flatten().filter(|r| r.is_valid()).count() as u64;
         stats.packets += tile.packets.len() as u64;
-        let frustum = || common_origin_frustum(&tile, &all).or_else(|| toward.and_then(|t| toward_frustum(rays, t)));
-        let traced = match self.options.method {
-            Method::Frustum => frustum().map(|f| {
-                self.tree.occluded_frustum(&f, &tile, &all, self.options.cull, &mut blocked, stats);
-            }),
-            Method::Mft => self
-                .quadrants(&tile, rays, toward, common_origin_frustum, toward_frustum)
-                .and_then(|(b, sets)| Some((Frustum4::new(b)?, sets)))
-                .map(|(f4, sets)| self.tree.occluded_mft(&f4, &tile, &sets, self.options.cull, &mut blocked, stats)),
-            Method::Cone => common_origin_cone(&tile, &all)
-                .or_else(|| toward.and_then(|t| toward_cone(rays, t)))
-                .map(|c| self.tree.occluded_frustum(&c, &tile, &all, self.options.cull, &mut blocked, stats)),
-            Method::MftCone => self
-                .quadrants(&tile, rays, toward, common_origin_cone, toward_cone)
-                .and_then(|(b, sets)| Some((Cone4::new(b)?, sets)))
-                .map(|(c4, sets)| self.tree.occluded_mft(&c4, &tile, &sets, self.options.cull, &mut blocked, stats)),
-            _ => None,
-        };
-        if traced.is_none() {
-            for (p, b) in tile.packets.iter().zip(blocked.iter_mut()) {
-                *b = self.tree.occluded_packet(p, stats);
+        let limit = self.options.shadow_spread_limit;
+        // Packets no bundle covers are traced as packets afterwards.
+        let mut leftover: Option<Vec<usize>> = None;
+        match self.options.method {
+            Method::Frustum => {
+                match common_origin_frustum(&tile, &all).or_else(|| toward.and_then(|t| toward_frustum(rays, t, limit)))
+                {
+                    Some(f) => self.tree.occluded_frustum(&f, &tile, &all, self.options.cull, &mut blocked, stats),
+                    None => leftover = Some(all.clone()),
+                }
             }
+            Method::Cone => {
+                match common_origin_cone(&tile, &all).or_else(|| toward.and_then(|t| toward_cone(rays, t, limit))) {
+                    Some(c) => self.tree.occluded_frustum(&c, &tile, &all, self.options.cull, &mut blocked, stats),
+                    None => leftover = Some(all.clone()),
+                }
+            }
+            Method::Mft => match self.quadrants(&tile, rays, toward, common_origin_frustum, toward_frustum) {
+                Some((b, sets, rest)) => {
+                    if let Some(f4) = Frustum4::new(b) {
+                        self.tree.occluded_mft(&f4, &tile, &sets, self.options.cull, &mut blocked, stats);
+                    }
+                    leftover = Some(rest);
+                }
+                None => leftover = Some(all.clone()),
+            },
+            Method::MftCone => match self.quadrants(&tile, rays, toward, common_origin_cone, toward_cone) {
+                Some((b, sets, rest)) => {
+                    if let Some(c4) = Cone4::new(b) {
+                        self.tree.occluded_mft(&c4, &tile, &sets, self.options.cull, &mut blocked, stats);
+                    }
+                    leftover = Some(rest);
+                }
+                None => leftover = Some(all.clone()),
+            },
+            _ => leftover = Some(all.clone()),
+        }
+        for j in leftover.unwrap_or_default() {
+            blocked[j] = self.tree.occluded_packet(&tile.packets[j], stats);
         }
         for (j, b) in blocked.iter().enumerate() {
             let bits = b.bits();
@@ -212,7 +243,7 @@ impl<'a> Tracer<'a> {
         rays: &[Option<Ray>],
         toward: Option<Vec3>,
         common: fn(&PacketTile<V>, &[usize]) -> Option<B>,
-        toward_fn: fn(&[Option<Ray>], Vec3) -> Option<B>,
+        toward_fn: fn(&[Option<Ray>], Vec3, f32) -> Option<B>,
     ) -> Option<Quadrants<B>> {
         let ph = PacketTile::<V>::PACKET_H;
         let (cx, cy) = (tile.cols.div_ceil(2) * 2, tile.rows.div_ceil(2) * ph);
@@ -220,6 +251,7 @@ impl<'a> Tracer<'a> {
         let quads = [(0, 0, cx.min(w), cy.min(h)), (cx, 0, w, cy.min(h)), (0, cy, cx.min(w), h), (cx, cy, w, h)];
         let mut sets: [Vec<usize>; 4] = Default::default();
         let mut bundles = [None; 4];
+        let mut rest = Vec::new();
         let mut origin = None;
         for (i, &(x0, y0, x1, y1)) in quads.iter().enumerate() {
             if x0 >= x1 || y0 >= y1 {
@@ -235,7 +267,14 @@ impl<'a> Tracer<'a> {
                     let t = toward?;
                     let sub: Vec<Option<Ray>> =
                         (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| rays[y * w + x]).collect();
-                    (toward_fn(&sub, t)?, t)
+                    match toward_fn(&sub, t, self.options.shadow_spread_limit) {
+                        Some(b) => (b, t),
+                        None => {
+                            // Too wide (or not ending at the light): its packets go the packet way.
+                            rest.extend(set);
+                            continue;
+                        }
+                    }
                 }
             };
             // All four must share one origin.
@@ -245,7 +284,7 @@ impl<'a> Tracer<'a> {
             bundles[i] = Some(b);
             sets[i] = set;
         }
-        Some((bundles, sets))
+        Some((bundles, sets, rest))
     }
 }
 
@@ -275,8 +314,8 @@ fn common_origin_cone<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Co
 
 /// The cone, seen from `toward`, of segments that end there (shadow rays to a light), like
 /// [`toward_frustum`].
-fn toward_cone(rays: &[Option<Ray>], toward: Vec3) -> Option<Cone> {
-    let (segs, slack) = toward_segments(rays, toward)?;
+fn toward_cone(rays: &[Option<Ray>], toward: Vec3, spread_limit: f32) -> Option<Cone> {
+    let (segs, slack) = toward_segments(rays, toward, spread_limit)?;
     let mut c = Cone::bounding(toward, segs.iter().copied())?;
     let scale = toward.abs().max_element() + c.t_max;
     c.origin_slack = slack * 2.0 + scale * 4.0 * f32::EPSILON;
@@ -289,15 +328,17 @@ fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option
     Frustum::from_packets(common_origin(tile, set)?, &tile.packets, set)
 }
 
-/// A tile's four quadrant bundles (empty quadrants are `None`) and the packets each bounds.
-type Quadrants<B> = ([Option<B>; 4], [Vec<usize>; 4]);
+/// A tile's four quadrant bundles (empty quadrants are `None`), the packets each bounds, and the packets left
+/// to trace as packets.
+type Quadrants<B> = ([Option<B>; 4], [Vec<usize>; 4], Vec<usize>);
 
 /// A segment seen from a light: unit direction, start and end distance.
 type Segment = (Vec3, f32, f32);
 
 /// The segments of `rays` seen from `toward`, and how far their ends miss it; `None` when some segment does
-/// not end near it.
-fn toward_segments(rays: &[Option<Ray>], toward: Vec3) -> Option<(Vec<Segment>, f32)> {
+/// not end near it, or when the bundle spreads wider than `spread_limit` (see
+/// [`TraceOptions::shadow_spread_limit`]).
+fn toward_segments(rays: &[Option<Ray>], toward: Vec3, spread_limit: f32) -> Option<(Vec<Segment>, f32)> {
     let mut slack = 0.0f32;
     let mut segs = Vec::new();
     for r in rays.iter().flatten().filter(|r| r.is_valid()) {
@@ -315,13 +356,18 @@ fn toward_segments(rays: &[Option<Ray>], toward: Vec3) -> Option<(Vec<Segment>, 
         slack = slack.max(gap);
         segs.push((v / len, 0.0, len));
     }
-    Some((segs, slack))
+    let mean = segs.iter().fold(Vec3::ZERO, |m, s| m + s.0).normalize_or_zero();
+    let spread = segs.iter().fold(0.0f32, |m, s| {
+        let c = s.0.dot(mean);
+        m.max(if c > 0.0 { s.0.cross(mean).length() / c } else { f32::INFINITY })
+    });
+    (spread <= spread_limit).then_some((segs, slack))
 }
 
 /// The frustum, seen from `toward`, of segments that end there (shadow rays to a light): the thesis traces
 /// shadow rays from the light toward the surface points. `None` when some segment does not end near it.
-fn toward_frustum(rays: &[Option<Ray>], toward: Vec3) -> Option<Frustum> {
-    let (segs, slack) = toward_segments(rays, toward)?;
+fn toward_frustum(rays: &[Option<Ray>], toward: Vec3, spread_limit: f32) -> Option<Frustum> {
+    let (segs, slack) = toward_segments(rays, toward, spread_limit)?;
     let mut f = Frustum::bounding(toward, segs)?;
     // Cover the rounding of the segments' ends and of the positions themselves.
     let scale = toward.abs().max_element() + f.t_max;
