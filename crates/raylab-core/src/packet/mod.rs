@@ -148,6 +148,16 @@ impl<V: Vf32> PacketHits<V> {
         Self { t: p.tmax, u: V::splat(0.0), v: V::splat(0.0), tri: [u32::MAX; MAX_LANES], hit: V::Mask::from_bits(0) }
     }
 
+    /// The hits of all lanes at once (cheaper than [`PacketHits::get`] per lane).
+    pub fn to_hits(&self) -> [Option<Hit>; MAX_LANES] {
+        let (mut t, mut u, mut v) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
+        self.t.write_to(&mut t[..V::LANES]);
+        self.u.write_to(&mut u[..V::LANES]);
+        self.v.write_to(&mut v[..V::LANES]);
+        let bits = self.hit.bits();
+        std::array::from_fn(|i| (bits >> i & 1 == 1).then(|| Hit { t: t[i], tri: self.tri[i], u: u[i], v: v[i] }))
+    }
+
     /// The hit of lane `i`.
     pub fn get(&self, i: usize) -> Option<Hit> {
         (self.hit.bits() >> i & 1 == 1).then(|| Hit {

@@ -137,7 +137,7 @@ impl<'a> Tracer<'a> {
     ) {
         let mut tile = PacketTile::<V>::new(rays, width, height);
         let all: Vec<usize> = (0..tile.packets.len()).collect();
-        stats.rays += rays.iter().flatten().filter(|r| r.is_valid()).count() as u64;
+        stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.len() as u64;
         match self.options.method {
             Method::Frustum => match common_origin_frustum(&tile, &all) {
@@ -164,8 +164,9 @@ impl<'a> Tracer<'a> {
             },
             _ => self.packets_intersect(&mut tile, stats),
         }
-        for j in 0..tile.packets.len() {
-            tile.for_each_lane(j, |pixel, lane| out[pixel] = tile.hits[j].get(lane));
+        for (j, hits) in tile.hits.iter().enumerate() {
+            let lanes = hits.to_hits();
+            tile.for_each_lane(j, |pixel, lane| out[pixel] = lanes[lane]);
         }
     }
 
@@ -187,7 +188,7 @@ impl<'a> Tracer<'a> {
         let tile = PacketTile::<V>::new(rays, width, height);
         let mut blocked = vec![V::Mask::from_bits(0); tile.packets.len()];
         let all: Vec<usize> = (0..tile.packets.len()).collect();
-        stats.rays += rays.iter().flatten().filter(|r| r.is_valid()).count() as u64;
+        stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.len() as u64;
         let limit = self.options.shadow_spread_limit;
         // Packets no bundle covers are traced as packets afterwards.
