@@ -26,13 +26,17 @@ struct Entry {
 
 const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 
-/// The two children's boxes of `b` split on `axis` at `split`: (left, right).
+/// The children of an inner node as a bundle from `origin` meets them: the front child (on the origin's side,
+/// entered first, thesis 4.1.2) and its box, then the back child's box; the back child is `front ^ 1`.
 #[inline(always)]
-pub(super) fn child_boxes(b: &Aabb, axis: usize, split: f32) -> (Aabb, Aabb) {
-    let (mut l, mut r) = (*b, *b);
+pub(super) fn front_and_back(n: super::KdNode, origin: glam::Vec3, bounds: &Aabb) -> (usize, Aabb, Aabb) {
+    let (axis, split) = (n.axis(), n.split());
+    let origin_right = split - origin[axis] < 0.0;
+    let (mut l, mut r) = (*bounds, *bounds);
     l.max[axis] = split;
     r.min[axis] = split;
-    (l, r)
+    let front = n.left() | origin_right as usize;
+    if origin_right { (front, r, l) } else { (front, l, r) }
 }
 
 /// A leaf reached by a frustum walk: its triangle ids, its box, and the distance at which the bundle can
@@ -191,12 +195,8 @@ impl KdTree {
             let n = nodes[node];
             visited += 1;
             if !n.is_leaf() {
-                let (axis, split) = (n.axis(), n.split());
-                let (lo, hi) = f.crossing(axis, split);
-                let origin_right = split - origin[axis] < 0.0;
-                let front = n.left() | origin_right as usize;
-                let (left_box, right_box) = child_boxes(&bounds, axis, split);
-                let (front_box, back_box) = if origin_right { (right_box, left_box) } else { (left_box, right_box) };
+                let (lo, hi) = f.crossing(n.axis(), n.split());
+                let (front, front_box, back_box) = front_and_back(n, origin, &bounds);
                 if hi < near * (1.0 - SPLIT_SLACK) {
                     (node, bounds) = (front ^ 1, back_box);
                 } else if lo > far * (1.0 + SPLIT_SLACK) {

@@ -9,7 +9,7 @@
 
 use raylab_simd::{VMask, Vf32};
 
-use super::frustum::{Leaf, child_boxes, hit_limit, leaf_intersect, leaf_occlude};
+use super::frustum::{Leaf, front_and_back, hit_limit, leaf_intersect, leaf_occlude};
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::Aabb;
@@ -167,12 +167,8 @@ impl KdTree {
             let n = nodes[node];
             visited += 1;
             if !n.is_leaf() {
-                let (axis, split) = (n.axis(), n.split());
-                let (lo, hi) = f.crossing(axis, split);
-                let origin_right = split - origin[axis] < 0.0;
-                let front = n.left() | origin_right as usize;
-                let (left_box, right_box) = child_boxes(&bounds, axis, split);
-                let (front_box, back_box) = if origin_right { (right_box, left_box) } else { (left_box, right_box) };
+                let (lo, hi) = f.crossing(n.axis(), n.split());
+                let (front, front_box, back_box) = front_and_back(n, origin, &bounds);
                 // Per frustum: all its rays cross before its interval (back only) or after it (front only).
                 let back_only = hi.lt(near * lo_slack);
                 let front_only = lo.gt(far * hi_slack);

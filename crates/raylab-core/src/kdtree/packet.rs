@@ -12,7 +12,7 @@ use raylab_simd::{VMask, Vf32};
 
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
-use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
+use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet, slab_interval};
 use crate::stats::TraversalStats;
 
 #[derive(Clone, Copy)]
@@ -29,27 +29,6 @@ const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 struct Stack<V: Vf32> {
     entries: [Entry<V>; STACK],
     len: usize,
-}
-
-/// Per-lane entry and exit distances of the packet's rays in the root box; a lane with a zero direction
-/// component is constrained by that slab only through its origin.
-fn clip_root<V: Vf32>(tree: &KdTree, p: &RayPacket<V>) -> (V, V) {
-    let b = tree.bounds();
-    let mut t_near = p.tmin;
-    let mut t_far = p.tmax;
-    let inf = V::splat(f32::INFINITY);
-    for k in 0..3 {
-        let (lo, hi) = (V::splat(b.min[k]), V::splat(b.max[k]));
-        let parallel = p.inv[k].abs().eq(inf);
-        let outside = p.org[k].lt(lo) | p.org[k].gt(hi);
-        let ta = (lo - p.org[k]) * p.inv[k];
-        let tb = (hi - p.org[k]) * p.inv[k];
-        let enter = V::select(parallel, V::select(outside, inf, V::splat(f32::NEG_INFINITY)), ta.min(tb));
-        let exit = V::select(parallel, V::select(outside, V::splat(f32::NEG_INFINITY), inf), ta.max(tb));
-        t_near = t_near.max(enter);
-        t_far = t_far.min(exit);
-    }
-    (t_near, t_far)
 }
 
 /// Lanes whose interval is non-empty, allowing the same slack as single-ray traversal.
@@ -105,7 +84,7 @@ impl KdTree {
         if self.triangles().is_empty() || p.valid.none() {
             return;
         }
-        let (mut t_near, mut t_far) = clip_root(self, p);
+        let (mut t_near, mut t_far) = slab_interval(p, &self.bounds(), p.tmin, p.tmax);
         let mut active = p.valid & nonempty(t_near, t_far);
         if active.none() {
             return;

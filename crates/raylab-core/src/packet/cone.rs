@@ -100,10 +100,6 @@ impl Bundle for Cone {
         (self.t_min, self.t_max)
     }
 
-    fn origin_slack(&self) -> f32 {
-        self.origin_slack
-    }
-
     /// Listing 4.3 with the omni-directional rule: the two edge depths, negative ones made infinite, sorted.
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (f32, f32) {

@@ -11,7 +11,7 @@ use raylab_simd::{VMask, Vf32};
 use crate::ray::{Hit, Ray};
 
 pub use cone::{Cone, Cone4};
-pub use tile::{Bundle, Bundle4, Frustum, PacketTile, overlaps_box};
+pub use tile::{Bundle, Bundle4, Frustum, PacketTile, overlaps_box, slab_interval};
 pub use woop::{intersect_packet, occlude_packet};
 
 /// Most lanes a packet may have (8 for AVX).

@@ -78,12 +78,12 @@ impl<V: Vf32> PacketTile<V> {
     }
 }
 
-/// The lanes of `p` whose ray overlaps box `b` within `(tmin, limit]` (the packet/leaf culling test of
-/// thesis 4.1.4), with the slab test's handling of zero direction components.
+/// Per lane, the interval `[t0, t1]` in which the packet's ray is inside box `b`, clipped to `[tmin, tmax]`
+/// (empty when `t0 > t1`). A lane with a zero direction component is constrained by that slab only through
+/// its origin; the fast path skips that case when no lane has one.
 #[inline(always)]
-pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -> V::Mask {
-    let mut t0 = p.tmin;
-    let mut t1 = limit;
+pub fn slab_interval<V: Vf32>(p: &RayPacket<V>, b: &Aabb, tmin: V, tmax: V) -> (V, V) {
+    let (mut t0, mut t1) = (tmin, tmax);
     if p.finite_inv {
         for k in 0..3 {
             let ta = (V::splat(b.min[k]) - p.org[k]) * p.inv[k];
@@ -105,6 +105,14 @@ pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -
             t1 = t1.min(exit);
         }
     }
+    (t0, t1)
+}
+
+/// The lanes of `p` whose ray overlaps box `b` within `(tmin, limit]` (the packet/leaf culling test of
+/// thesis 4.1.4), allowing `slack`.
+#[inline(always)]
+pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -> V::Mask {
+    let (t0, t1) = slab_interval(p, b, p.tmin, limit);
     p.valid & (t0 * V::splat(1.0 - slack)).le(t1 * V::splat(1.0 + slack))
 }
 
@@ -115,8 +123,6 @@ pub trait Bundle {
     fn origin(&self) -> Vec3;
     /// The range of distances the walk starts with.
     fn t_range(&self) -> (f32, f32);
-    /// How far the rays may pass from the origin (see [`Frustum::origin_slack`]).
-    fn origin_slack(&self) -> f32;
     /// The range of distances at which the bundle crosses the plane `coordinate k = split`; infinite bounds
     /// mean "some ray never crosses in front of the origin".
     fn crossing(&self, k: usize, split: f32) -> (f32, f32);
@@ -140,9 +146,6 @@ impl Bundle for Frustum {
     }
     fn t_range(&self) -> (f32, f32) {
         (self.t_min, self.t_max)
-    }
-    fn origin_slack(&self) -> f32 {
-        self.origin_slack
     }
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
