@@ -58,7 +58,7 @@ pub const BUILTINS: [BuiltinInfo; 4] = [
     },
     BuiltinInfo {
         name: "forest",
-        summary: "forest floor with dense small-triangle detail: trees, leaves, grass (~175k tris)",
+        summary: "forest floor with dense small-triangle detail: trees, leaves, grass (~180k tris)",
         build: forest::build,
     },
 ];
