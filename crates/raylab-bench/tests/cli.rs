@@ -120,3 +120,60 @@ fn tables_print_the_thesis_tables() {
         assert!(md.contains(t), "missing {t} in:\n{md}");
     }
 }
+
+#[test]
+fn render_is_the_same_for_every_method_and_backend() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut images = Vec::new();
+    for extra in [
+        &["--method", "mono", "--order", "hilbert"][..],
+        &["--method", "packet"][..],
+        &["--method", "mft", "--tile", "8"][..],
+        &["--method", "mft-cone", "--tile", "16", "--backend", "scalar"][..],
+        &["--method", "frustum", "--tile", "4", "--no-cull"][..],
+    ] {
+        let out = dir.path().join(format!("{}.png", images.len()));
+        let mut args =
+            vec!["render", "--scene", "arena", "--width", "48", "--height", "40", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = bench(&args, dir.path());
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        images.push(image::open(&out).unwrap().to_rgba8());
+    }
+    for (k, img) in images.iter().enumerate().skip(1) {
+        assert_eq!(img.as_raw(), images[0].as_raw(), "render {k} differs from mono");
+    }
+}
+
+#[test]
+fn trace_reports_the_same_checksum_on_every_backend() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut sums = Vec::new();
+    for backend in ["sse2", "scalar"] {
+        let o = bench(
+            &[
+                "trace",
+                "--scene",
+                "kitchen",
+                "--width",
+                "40",
+                "--height",
+                "40",
+                "--method",
+                "mft",
+                "--tile",
+                "8",
+                "--reps",
+                "1",
+                "--backend",
+                backend,
+                "--json",
+            ],
+            dir.path(),
+        );
+        assert!(o.status.success(), "{backend}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        sums.push((v["result"]["hits"].as_u64().unwrap(), v["result"]["sum_t"].as_f64().unwrap()));
+    }
+    assert_eq!(sums[0], sums[1]);
+}
