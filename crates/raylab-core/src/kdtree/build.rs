@@ -67,6 +67,47 @@ impl Event {
 
 type Events = [Vec<Event>; 3];
 
+/// Buffers reused from node to node, so a build allocates a few times per thread instead of about fifteen
+/// times per node: the side of each triangle, the straddling triangles, their new events, and a free list of
+/// event vectors that children take and consumed parents give back.
+struct Scratch {
+    side: Vec<u8>,
+    straddlers: Vec<u32>,
+    new_l: Events,
+    new_r: Events,
+    free: Vec<Vec<Event>>,
+}
+
+impl Scratch {
+    /// Most vectors kept on the free list.
+    const MAX_FREE: usize = 64;
+
+    fn new(n_tris: usize) -> Self {
+        Self {
+            side: vec![0; n_tris],
+            straddlers: Vec::new(),
+            new_l: Default::default(),
+            new_r: Default::default(),
+            free: Vec::new(),
+        }
+    }
+
+    fn take(&mut self, capacity: usize) -> Vec<Event> {
+        let mut v = self.free.pop().unwrap_or_default();
+        v.clear();
+        v.reserve(capacity);
+        v
+    }
+
+    fn give(&mut self, events: Events) {
+        for v in events {
+            if v.capacity() > 0 && self.free.len() < Self::MAX_FREE {
+                self.free.push(v);
+            }
+        }
+    }
+}
+
 struct Task {
     bounds: Aabb,
     events: Events,
@@ -120,11 +161,11 @@ fn build_parallel(ctx: &Ctx, task: Task) -> BuildOutput {
     let Some(split) = find_split(ctx, &task) else {
         return build_sequential(ctx, task);
     };
-    let mut side = vec![0u8; ctx.tris.len()];
+    let mut scratch = Scratch::new(ctx.tris.len());
     let axis = split.axis as u8;
     let pos = split.pos;
-    let (l, r) = partition(ctx, task, &split, &mut side);
-    drop(side);
+    let (l, r) = partition(ctx, task, &split, &mut scratch);
+    drop(scratch);
     let (lo, ro) = rayon::join(|| build_parallel(ctx, l), || build_parallel(ctx, r));
     splice(axis, pos, lo, ro)
 }
@@ -153,7 +194,7 @@ fn splice(axis: u8, split: f32, lo: BuildOutput, ro: BuildOutput) -> BuildOutput
 /// Builds a subtree depth-first with an explicit stack.
 fn build_sequential(ctx: &Ctx, root: Task) -> BuildOutput {
     let mut out = BuildOutput { nodes: vec![BuildNode::Leaf { first: 0, count: 0 }], tri_ids: Vec::new() };
-    let mut side = vec![0u8; ctx.tris.len()];
+    let mut scratch = Scratch::new(ctx.tris.len());
     let mut stack = vec![(0usize, root)];
     while let Some((idx, task)) = stack.pop() {
         match find_split(ctx, &task) {
@@ -161,13 +202,14 @@ fn build_sequential(ctx: &Ctx, root: Task) -> BuildOutput {
                 let first = out.tri_ids.len() as u32;
                 out.tri_ids.extend(task.events[0].iter().filter(|e| e.kind() != END).map(|e| e.tri() as u32));
                 out.nodes[idx] = BuildNode::Leaf { first, count: task.n as u32 };
+                scratch.give(task.events);
             }
             Some(split) => {
                 let left = out.nodes.len();
                 out.nodes.push(BuildNode::Leaf { first: 0, count: 0 });
                 out.nodes.push(BuildNode::Leaf { first: 0, count: 0 });
                 out.nodes[idx] = BuildNode::Inner { axis: split.axis as u8, split: split.pos, left: left as u32 };
-                let (l, r) = partition(ctx, task, &split, &mut side);
+                let (l, r) = partition(ctx, task, &split, &mut scratch);
                 stack.push((left + 1, r));
                 stack.push((left, l));
             }
@@ -294,8 +336,9 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
 }
 
 /// Distributes the node's events to its children (Wald and Havran 2006, section 4.3).
-fn partition(ctx: &Ctx, task: Task, split: &Split, side: &mut [u8]) -> (Task, Task) {
+fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Task, Task) {
     let (axis, pos) = (split.axis, split.pos);
+    let side = &mut scratch.side;
     // One sweep classifies every triangle: a start event comes before its end event, so the start sets the
     // side to right-only or both, and the end turns "both" into left-only when it lies at or before `pos`.
     for e in &task.events[axis] {
@@ -312,7 +355,8 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, side: &mut [u8]) -> (Task, Ta
     lb.max[axis] = pos;
     rb.min[axis] = pos;
 
-    let mut straddlers = Vec::new();
+    let straddlers = &mut scratch.straddlers;
+    straddlers.clear();
     let (mut nl, mut nr) = (0, 0);
     for e in task.events[axis].iter().filter(|e| e.kind() != END) {
         match side[e.tri()] {
@@ -321,9 +365,9 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, side: &mut [u8]) -> (Task, Ta
             _ => straddlers.push(e.tri() as u32),
         }
     }
-    let mut new_l: Events = Default::default();
-    let mut new_r: Events = Default::default();
-    for &t in &straddlers {
+    let (mut new_l, mut new_r) = (std::mem::take(&mut scratch.new_l), std::mem::take(&mut scratch.new_r));
+    new_l.iter_mut().chain(new_r.iter_mut()).for_each(Vec::clear);
+    for &t in straddlers.iter() {
         let tri = &ctx.tris[t as usize];
         if let Some(b) = clipped_bounds(tri, &lb) {
             nl += 1;
@@ -343,19 +387,28 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, side: &mut [u8]) -> (Task, Ta
     for a in 0..3 {
         new_l[a].sort_unstable_by_key(|e| e.key());
         new_r[a].sort_unstable_by_key(|e| e.key());
-        (left[a], right[a]) = split_events(&task.events[a], side, &new_l[a], &new_r[a]);
+        // Reserving the parent's size for both children over-allocates, but memory never touched costs next
+        // to nothing, while counting first would take two more passes over the events.
+        left[a] = scratch.take(task.events[a].len() + new_l[a].len());
+        right[a] = scratch.take(task.events[a].len() + new_r[a].len());
+        split_events(&task.events[a], &scratch.side, &new_l[a], &new_r[a], &mut left[a], &mut right[a]);
     }
+    (scratch.new_l, scratch.new_r) = (new_l, new_r);
+    scratch.give(task.events);
     let depth = task.depth + 1;
     (Task { bounds: lb, events: left, n: nl, depth }, Task { bounds: rb, events: right, n: nr, depth })
 }
 
 /// Sends each event of `old` to the side of its triangle (dropping the straddlers' old events) and merges in
 /// the straddlers' new, sorted events, in one pass that keeps both outputs sorted by [`Event::key`].
-fn split_events(old: &[Event], side: &[u8], new_l: &[Event], new_r: &[Event]) -> (Vec<Event>, Vec<Event>) {
-    // Reserving the parent's size for both children over-allocates, but memory that is never touched costs
-    // next to nothing, while counting first would take two more passes over the events.
-    let mut left = Vec::with_capacity(old.len() + new_l.len());
-    let mut right = Vec::with_capacity(old.len() + new_r.len());
+fn split_events(
+    old: &[Event],
+    side: &[u8],
+    new_l: &[Event],
+    new_r: &[Event],
+    left: &mut Vec<Event>,
+    right: &mut Vec<Event>,
+) {
     let (mut i, mut j) = (0, 0);
     for &e in old {
         let key = e.key();
@@ -379,5 +432,4 @@ fn split_events(old: &[Event], side: &[u8], new_l: &[Event], new_r: &[Event]) ->
     }
     left.extend_from_slice(&new_l[i..]);
     right.extend_from_slice(&new_r[j..]);
-    (left, right)
 }
