@@ -87,11 +87,6 @@ impl Aabb {
         }
     }
 
-    /// True when `p` lies inside or on the boundary.
-    pub fn contains(&self, p: Vec3) -> bool {
-        p.cmpge(self.min).all() && p.cmple(self.max).all()
-    }
-
     /// The box grown on every side by `pad` times its diagonal plus `pad` times the largest coordinate
     /// magnitude, so that it also grows for flat boxes and for boxes far from the origin.
     pub fn padded(&self, pad: f32) -> Self {

@@ -60,11 +60,6 @@ impl MeshBuilder {
         self.transform = saved;
     }
 
-    /// Number of triangles so far.
-    pub fn triangle_count(&self) -> usize {
-        self.scene.triangles.len()
-    }
-
     /// Finishes the scene.
     pub fn build(self) -> Scene {
         self.scene.build()

@@ -129,3 +129,48 @@ fn counters_add_up() {
     assert!(hits > 128, "the default view looks at geometry ({hits} hits)");
     assert!(s.leaves >= 256 && s.nodes > s.leaves && s.isect_tests > 0, "{s:?}");
 }
+
+/// Every coherent method against brute force on the adversarial rays (different origins, zero and -0
+/// direction components, mixed signs, vertex- and edge-aimed, in split planes, segments), traced as 4x2
+/// tiles: frustum methods find no common origin and trace packets with mixed origins, which is exactly what
+/// this exercises.
+#[test]
+fn coherent_methods_match_brute_force_on_adversarial_rays() {
+    use raylab_core::method::Method;
+    use raylab_core::reference::BruteForce;
+    use raylab_core::trace::{TraceOptions, Tracer};
+    use raylab_simd::Backend;
+    for name in builtin::names() {
+        let scene = builtin::build(name, Detail::Test).unwrap();
+        let t = tree(&scene);
+        let bf = BruteForce::new(&scene);
+        let rays: Vec<Option<Ray>> = adversarial_rays(&scene, &t, 120, 23).into_iter().map(Some).collect();
+        for method in [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone] {
+            for backend in Backend::available() {
+                let tracer = Tracer::new(&t, None, TraceOptions { method, backend, ..Default::default() });
+                let mut s = TraversalStats::default();
+                for chunk in rays.chunks(8) {
+                    let mut tile = chunk.to_vec();
+                    tile.resize(8, None);
+                    let (mut hits, mut occ) = (vec![None; 8], vec![false; 8]);
+                    tracer.intersect_tile(&tile, 4, 2, &mut hits, &mut s);
+                    tracer.occluded_tile(&tile, 4, 2, None, &mut occ, &mut s);
+                    for (i, r) in chunk.iter().enumerate() {
+                        let r = r.as_ref().unwrap();
+                        let want = bf.intersect(r, &mut s);
+                        let ok = match (hits[i], want) {
+                            (None, None) => true,
+                            (Some(g), Some(w)) => {
+                                (g.t - w.t).abs() <= common::T_REL_TOL * w.t.abs()
+                                    && (g.tri == w.tri || bf.hit_distance(r, g.tri) == Some(g.t))
+                            }
+                            _ => false,
+                        };
+                        assert!(ok, "{name} {method} {backend:?}: {r:?}: got {:?}, reference {want:?}", hits[i]);
+                        assert_eq!(occ[i], bf.occluded(r, &mut s), "{name} {method} {backend:?}: occlusion of {r:?}");
+                    }
+                }
+            }
+        }
+    }
+}

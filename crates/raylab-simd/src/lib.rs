@@ -77,8 +77,6 @@ pub trait Vf32:
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
     /// Lane-wise absolute value.
     fn abs(self) -> Self;
-    /// Lanes whose sign bit is set (including -0.0 and negative NaN).
-    fn sign_mask(self) -> Self::Mask;
     /// Smallest lane (NaN lanes are ignored unless all are NaN).
     #[inline(always)]
     fn reduce_min(self) -> f32 {
@@ -147,8 +145,6 @@ mod tests {
         assert!(mx.lane(2).is_nan(), "NaN in the second operand is returned");
         assert_eq!(V::select(V::Mask::from_bits(0b0101), a, b).lane(1), 3.0);
         assert_eq!(a.abs().lane(1), 2.0);
-        assert_eq!(a.sign_mask().bits() & 0b1011, 0b0010);
-        assert_eq!(b.sign_mask().bits(), 0b1000, "-0.0 has its sign bit set");
         assert_eq!(a.reduce_min(), -2.0);
         assert_eq!(a.reduce_max(), 1.0);
         let mut out = [0.0; 4];

@@ -127,8 +127,4 @@ impl Vf32 for F32x4 {
     fn abs(self) -> Self {
         Self(self.0.map(f32::abs))
     }
-    #[inline(always)]
-    fn sign_mask(self) -> M32x4 {
-        Self::mask(|i| self.0[i].is_sign_negative())
-    }
 }

@@ -140,8 +140,4 @@ impl Vf32 for F32x4 {
     fn abs(self) -> Self {
         Self(sse!(_mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff)))))
     }
-    #[inline(always)]
-    fn sign_mask(self) -> M32x4 {
-        M32x4(sse!(_mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(self.0), 31))))
-    }
 }

@@ -10,7 +10,6 @@ pub mod packet;
 mod params;
 mod stats;
 
-pub use clip::clipped_bounds;
 pub use node::{KdNode, MAX_INDEX};
 pub use params::{KdParams, SplitStrategy};
 pub use stats::KdStats;
