@@ -40,6 +40,12 @@ pub fn in_range(lo: u64, hi: u64) -> impl Fn(&str) -> Result<u64, String> + Clon
     }
 }
 
+/// Parses a finite number greater than zero.
+pub fn parse_positive(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("{v} must be finite and > 0")) }
+}
+
 /// The scene, camera and light flags.
 #[derive(Args, Clone, Debug)]
 pub struct SceneArgs {

@@ -2,11 +2,10 @@
 //!
 //! With no subcommand it renders the default built-in scene to `raylab.png`.
 
-mod args;
 mod commands;
-mod env;
-mod prepare;
 mod timing;
+
+use raylab_bench::{args, env, prepare};
 
 use clap::{Parser, Subcommand};
 

@@ -1,16 +1,12 @@
 //! `raylab-bench render`: one frame with the benchmark shading, written as PNG.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use clap::Args;
-use raylab_core::method::Method;
-use raylab_core::reference::BruteForce;
-use raylab_core::render::{RayOrder, RenderSettings, render};
-use raylab_core::trace::Tracer;
+use raylab_bench::still::{Still, render_still};
+use raylab_core::render::{FrameView, RayOrder, RenderSettings};
 
-use crate::args::{KdArgs, MethodArgs, SceneArgs, in_range};
-use crate::prepare::{build_tree, load_scene};
+use crate::args::{KdArgs, MethodArgs, SceneArgs, in_range, parse_positive};
 
 /// Renders one frame to a PNG file.
 #[derive(Args, Debug)]
@@ -36,13 +32,19 @@ pub struct RenderArgs {
     /// Skip the hard-shadow rays.
     #[arg(long)]
     no_shadows: bool,
+    /// What the image shows: shaded, nodes or isects (heat maps of the work per pixel), normals or depth.
+    #[arg(long, default_value = "shaded")]
+    show: FrameView,
+    /// Count at the hot end of the heat maps (default: the frame's maximum).
+    #[arg(long, value_parser = parse_positive)]
+    heat_max: Option<f32>,
     /// Worker threads (default: all CPUs).
     #[arg(long, value_parser = in_range(1, 1024))]
     threads: Option<u64>,
 }
 
 impl RenderArgs {
-    /// The default action of a bare `cargo run --release`: the default scene to `raylab.png`.
+    /// The default action of a bare `raylab-bench`: the default scene to `raylab.png`.
     pub fn default_scene() -> Self {
         use clap::Parser;
         #[derive(Parser)]
@@ -57,24 +59,19 @@ impl RenderArgs {
 /// Runs the command.
 pub fn run(a: &RenderArgs) -> Result<(), String> {
     let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
-    let (scene, load_s) = load_scene(&a.scene.source())?;
-    let (camera, light) = a.scene.camera_and_light(&scene)?;
-    let tree = build_tree(&scene, &a.kd.params()?, threads)?;
     let settings = RenderSettings {
         width: a.width as u32,
         height: a.height as u32,
         tile: a.m.tile as u32,
         order: a.order,
         shadows: !a.no_shadows,
+        view: a.show,
+        heat_max: a.heat_max,
     };
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
-    let t0 = Instant::now();
-    let reference = (a.m.method == Method::Reference).then(|| BruteForce::new(&scene));
-    let tracer = Tracer::new(&tree, reference.as_ref(), a.m.options());
-    let frame = pool.install(|| render(&scene, &tracer, &camera, light, &settings));
-    let render_s = t0.elapsed().as_secs_f64();
-    let rgba: Vec<u8> = frame.rgba.iter().flatten().copied().collect();
-    let img = image::RgbaImage::from_raw(frame.width, frame.height, rgba).ok_or("frame buffer size mismatch")?;
+    let Still { scene, tree, frame, load_s, render_s } =
+        render_still(&a.scene, &a.kd.params()?, a.m.options(), &settings, threads)?;
+    let img = image::RgbaImage::from_raw(frame.width, frame.height, frame.rgba.as_flattened().to_vec())
+        .ok_or("frame buffer size mismatch")?;
     img.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
     println!(
         "{}: {} triangles, loaded in {:.3} s, kd-tree in {:.3} s; rendered {}x{} with {} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",

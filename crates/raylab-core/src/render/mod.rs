@@ -1,17 +1,25 @@
 //! The tile renderer: the image is cut into square tiles that rayon threads take in turn (thesis chapter 6),
-//! each traced in the chosen [`RayOrder`] and shaded with [`shade`].
+//! each traced in the chosen [`RayOrder`] and shaded with [`shade`], or drawn as one of the diagnostic
+//! [`FrameView`]s.
 
 mod order;
 pub mod shade;
+mod stages;
+mod view;
 
 pub use order::RayOrder;
+pub use stages::StageTimes;
+pub use view::{FrameView, heat_color};
+
+use std::time::Instant;
 
 use glam::Vec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::method::Method;
 use crate::ray::Ray;
-use crate::scene::{Camera, PointLight, Scene};
+use crate::scene::{Camera, CameraRaster, PointLight, Scene};
 use crate::stats::TraversalStats;
 use crate::trace::Tracer;
 use shade::to_display;
@@ -29,11 +37,23 @@ pub struct RenderSettings {
     pub order: RayOrder,
     /// Trace hard shadows.
     pub shadows: bool,
+    /// What the frame shows.
+    pub view: FrameView,
+    /// Value at the hot end of the heat maps; `None` scales each frame to its own maximum.
+    pub heat_max: Option<f32>,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { width: 512, height: 512, tile: 16, order: RayOrder::Scanline, shadows: true }
+        Self {
+            width: 512,
+            height: 512,
+            tile: 16,
+            order: RayOrder::Scanline,
+            shadows: true,
+            view: FrameView::Shaded,
+            heat_max: None,
+        }
     }
 }
 
@@ -48,10 +68,22 @@ pub struct Frame {
     pub rgba: Vec<[u8; 4]>,
     /// Counters of primary and shadow rays together.
     pub stats: TraversalStats,
+    /// Time per stage, summed over threads.
+    pub stages: StageTimes,
+    /// For the heat-map and depth views, the values at the two ends of the colour scale (for a legend).
+    pub range: Option<(f32, f32)>,
 }
 
-/// A finished tile: (pixel index, colour) pairs and its counters.
-type TileResult = (Vec<(u32, [u8; 4])>, TraversalStats);
+/// One pixel as a tile leaves it: its index, its colour, and the value scalar views map to colour.
+type PixelOut = (u32, [u8; 4], f32);
+
+/// A finished tile.
+#[derive(Default)]
+struct TileOut {
+    pixels: Vec<PixelOut>,
+    stats: TraversalStats,
+    stages: StageTimes,
+}
 
 /// Renders `scene` from `camera` lit by `light`, tracing primary and shadow rays tile by tile with `tracer`
 /// (so the traversal method changes the speed, never the pixels). The work runs on the current rayon pool
@@ -59,61 +91,164 @@ type TileResult = (Vec<(u32, [u8; 4])>, TraversalStats);
 pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight, settings: &RenderSettings) -> Frame {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     let tile = settings.tile.max(1);
-    let raster = camera.raster(w, h);
     let bounds = scene.bounds();
-    let epsilon = if bounds.is_empty() { 0.0 } else { 1e-4 * bounds.diagonal() };
-    // Single rays are traced in the chosen order; packet methods need the tile's pixels row by row.
-    let order = if tracer.options.method.uses_packets() { RayOrder::Scanline } else { settings.order };
-    let offsets = order.offsets(tile, tile);
+    let ctx = TileContext {
+        scene,
+        tracer,
+        raster: camera.raster(w, h),
+        light,
+        settings,
+        width: w,
+        epsilon: if bounds.is_empty() { 0.0 } else { 1e-4 * bounds.diagonal() },
+        // Single rays are traced in the chosen order; packet methods need the tile's pixels row by row.
+        order: if tracer.options.method.uses_packets() { RayOrder::Scanline } else { settings.order },
+    };
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
-    let done: Vec<TileResult> = tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let mut stats = TraversalStats::default();
-            let (tw, th) = (tile.min(w - x0), tile.min(h - y0));
-            let pixels: Vec<(u32, u32)> =
-                offsets.iter().map(|&(dx, dy)| (x0 + dx, y0 + dy)).filter(|&(x, y)| x < w && y < h).collect();
-            let rays: Vec<Option<Ray>> = pixels.iter().map(|&(x, y)| Some(raster.primary(x, y))).collect();
-            let (rw, rh) = if order == RayOrder::Scanline { (tw as usize, th as usize) } else { (rays.len(), 1) };
-            let mut hits = vec![None; rays.len()];
-            tracer.intersect_tile(&rays, rw, rh, &mut hits, &mut stats);
-            let shadow: Vec<Option<Ray>> = rays
-                .iter()
-                .zip(&hits)
-                .map(|(r, h)| match (r, h) {
-                    (Some(r), Some(h)) if settings.shadows => shade::shadow_ray(scene, r, h, &light, epsilon),
-                    _ => None,
-                })
-                .collect();
-            let mut blocked = vec![false; rays.len()];
-            if shadow.iter().any(Option::is_some) {
-                tracer.occluded_tile(&shadow, rw, rh, Some(light.position), &mut blocked, &mut stats);
-            }
-            let px = pixels
-                .iter()
-                .enumerate()
-                .map(|(i, &(x, y))| {
-                    let c = match (&rays[i], &hits[i]) {
-                        (Some(r), Some(hit)) => {
-                            let visible = !settings.shadows || (shadow[i].is_some() && !blocked[i]);
-                            shade::shade(scene, r, hit, &light, visible)
-                        }
-                        _ => Vec3::ZERO,
-                    };
-                    (y * w + x, [to_display(c.x), to_display(c.y), to_display(c.z), 255])
-                })
-                .collect();
-            (px, stats)
-        })
-        .collect();
+    let done: Vec<TileOut> =
+        tiles.par_iter().map(|&(x0, y0)| ctx.tile(x0, y0, tile.min(w - x0), tile.min(h - y0))).collect();
+
     let mut rgba = vec![[0, 0, 0, 255]; (w * h) as usize];
     let mut stats = TraversalStats::default();
-    for (px, s) in done {
-        for (i, c) in px {
-            rgba[i as usize] = c;
+    let mut stages = StageTimes::default();
+    let range = settings.view.is_scalar().then(|| value_range(&done, settings));
+    for t in done {
+        for (i, c, v) in t.pixels {
+            rgba[i as usize] = match (settings.view, range) {
+                (FrameView::Depth, Some((near, far))) => depth_color(v, near, far),
+                (_, Some((_, hot))) => heat_color(if hot > 0.0 { v / hot } else { 0.0 }),
+                _ => c,
+            };
         }
-        stats += s;
+        stats += t.stats;
+        stages += t.stages;
     }
-    Frame { width: w, height: h, rgba, stats }
+    Frame { width: w, height: h, rgba, stats, stages, range }
+}
+
+/// The ends of a scalar view's colour scale: nearest and farthest hit for depth, zero and the largest (or the
+/// fixed) count for heat maps.
+fn value_range(tiles: &[TileOut], settings: &RenderSettings) -> (f32, f32) {
+    let values = || tiles.iter().flat_map(|t| t.pixels.iter().map(|p| p.2)).filter(|v| v.is_finite());
+    if settings.view == FrameView::Depth {
+        let near = values().fold(f32::INFINITY, f32::min);
+        let far = values().fold(f32::NEG_INFINITY, f32::max);
+        if near <= far { (near, far) } else { (0.0, 0.0) }
+    } else {
+        (0.0, settings.heat_max.filter(|m| m.is_finite() && *m > 0.0).unwrap_or_else(|| values().fold(0.0, f32::max)))
+    }
+}
+
+/// Grey level of a hit distance: white at the nearest hit, dark at the farthest, black for misses.
+fn depth_color(t: f32, near: f32, far: f32) -> [u8; 4] {
+    if !t.is_finite() {
+        return [0, 0, 0, 255];
+    }
+    let x = if far > near { (t - near) / (far - near) } else { 0.0 };
+    let g = to_display(1.0 - 0.9 * x);
+    [g, g, g, 255]
+}
+
+/// Edge of the blocks a method traces as one unit: a ray, a 2x2 packet, or the whole tile for frustums.
+fn unit_size(method: Method, tile: u32) -> u32 {
+    if method.uses_tiles() {
+        tile
+    } else if method.uses_packets() {
+        2
+    } else {
+        1
+    }
+}
+
+/// Everything a tile needs, shared by all tiles of a frame.
+struct TileContext<'a> {
+    scene: &'a Scene,
+    tracer: &'a Tracer<'a>,
+    raster: CameraRaster,
+    light: PointLight,
+    settings: &'a RenderSettings,
+    width: u32,
+    epsilon: f32,
+    order: RayOrder,
+}
+
+impl TileContext<'_> {
+    /// Renders the `tw x th` tile at `(x0, y0)`. Heat maps trace it unit by unit so that each unit's counters
+    /// can be shared among its own pixels; the units are exactly the pieces the method traces anyway.
+    fn tile(&self, x0: u32, y0: u32, tw: u32, th: u32) -> TileOut {
+        let mut out = TileOut::default();
+        let view = self.settings.view;
+        if !view.is_heat_map() {
+            self.block(x0, y0, tw, th, self.order, &mut out);
+            return out;
+        }
+        let unit = unit_size(self.tracer.options.method, self.settings.tile.max(1));
+        for uy in (0..th).step_by(unit as usize) {
+            for ux in (0..tw).step_by(unit as usize) {
+                let start = out.pixels.len();
+                let before = out.stats;
+                self.block(x0 + ux, y0 + uy, unit.min(tw - ux), unit.min(th - uy), RayOrder::Scanline, &mut out);
+                let work = if view == FrameView::Nodes {
+                    out.stats.nodes - before.nodes
+                } else {
+                    out.stats.isect_tests - before.isect_tests
+                };
+                let share = work as f32 / (out.pixels.len() - start).max(1) as f32;
+                for p in &mut out.pixels[start..] {
+                    p.2 = share;
+                }
+            }
+        }
+        out
+    }
+
+    /// Traces and shades the `bw x bh` block at `(x0, y0)` in `order`, appending its pixels to `out`.
+    fn block(&self, x0: u32, y0: u32, bw: u32, bh: u32, order: RayOrder, out: &mut TileOut) {
+        let (scene, light, settings) = (self.scene, &self.light, self.settings);
+        let t0 = Instant::now();
+        let pixels: Vec<(u32, u32)> = order.offsets(bw, bh).into_iter().map(|(dx, dy)| (x0 + dx, y0 + dy)).collect();
+        let rays: Vec<Option<Ray>> = pixels.iter().map(|&(x, y)| Some(self.raster.primary(x, y))).collect();
+        let (rw, rh) = if order == RayOrder::Scanline { (bw as usize, bh as usize) } else { (rays.len(), 1) };
+        let mut hits = vec![None; rays.len()];
+        self.tracer.intersect_tile(&rays, rw, rh, &mut hits, &mut out.stats);
+        let t1 = Instant::now();
+
+        // Only the shaded picture and the heat maps (which count the shadow work) need shadow rays.
+        let shadows =
+            settings.shadows && matches!(settings.view, FrameView::Shaded | FrameView::Nodes | FrameView::Isects);
+        let shadow: Vec<Option<Ray>> = rays
+            .iter()
+            .zip(&hits)
+            .map(|(r, h)| match (r, h) {
+                (Some(r), Some(h)) if shadows => shade::shadow_ray(scene, r, h, light, self.epsilon),
+                _ => None,
+            })
+            .collect();
+        let mut blocked = vec![false; rays.len()];
+        if shadow.iter().any(Option::is_some) {
+            self.tracer.occluded_tile(&shadow, rw, rh, Some(light.position), &mut blocked, &mut out.stats);
+        }
+        let t2 = Instant::now();
+
+        out.pixels.extend(pixels.iter().enumerate().map(|(i, &(x, y))| {
+            let index = y * self.width + x;
+            let (Some(r), Some(hit)) = (&rays[i], &hits[i]) else {
+                return (index, [0, 0, 0, 255], f32::INFINITY);
+            };
+            let c = match settings.view {
+                FrameView::Normals => shade::facing_normal(scene, r, hit) * 0.5 + Vec3::splat(0.5),
+                _ => {
+                    let visible = !shadows || (shadow[i].is_some() && !blocked[i]);
+                    shade::shade(scene, r, hit, light, visible)
+                }
+            };
+            (index, [to_display(c.x), to_display(c.y), to_display(c.z), 255], hit.t)
+        }));
+        let t3 = Instant::now();
+        out.stages += StageTimes {
+            primary: (t1 - t0).as_secs_f64(),
+            shadow: (t2 - t1).as_secs_f64(),
+            shading: (t3 - t2).as_secs_f64(),
+        };
+    }
 }

@@ -33,14 +33,7 @@ pub fn shadow_ray(scene: &Scene, ray: &Ray, hit: &Hit, light: &PointLight, epsil
 
 /// Linear RGB colour of a primary hit lit by `light`, `visible` telling whether the shadow ray got through.
 pub fn shade(scene: &Scene, ray: &Ray, hit: &Hit, light: &PointLight, visible: bool) -> Vec3 {
-    let mut n = scene.shading_normal(hit);
-    let mut ng = scene.geometric_normal(hit.tri as usize);
-    if ng.dot(ray.dir) > 0.0 {
-        ng = -ng;
-    }
-    if n.dot(ng) < 0.0 {
-        n = -n;
-    }
+    let n = facing_normal(scene, ray, hit);
     let material = &scene.materials[scene.triangles[hit.tri as usize].material as usize];
     let p = ray.at(hit.t);
     let to_light = light.position - p;
@@ -48,6 +41,16 @@ pub fn shade(scene: &Scene, ray: &Ray, hit: &Hit, light: &PointLight, visible: b
     let ndl = n.dot(to_light / dist).max(0.0);
     let direct = if visible { ndl * light.attenuation(dist) } else { 0.0 };
     material.base_color * (AMBIENT + DIRECT * direct * light.color)
+}
+
+/// The shading normal of a hit, turned to the side of the surface the ray came from (two-sided shading).
+pub fn facing_normal(scene: &Scene, ray: &Ray, hit: &Hit) -> Vec3 {
+    let n = scene.shading_normal(hit);
+    let mut ng = scene.geometric_normal(hit.tri as usize);
+    if ng.dot(ray.dir) > 0.0 {
+        ng = -ng;
+    }
+    if n.dot(ng) < 0.0 { -n } else { n }
 }
 
 /// Linear value to an 8-bit display value with the harness's gamma of 2.2.

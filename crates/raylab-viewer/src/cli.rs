@@ -1,0 +1,99 @@
+//! The viewer's command line: the scene, camera and method flags of `raylab-bench`, the window, and the
+//! automation flags that render a fixed number of frames, save a screenshot and exit.
+
+use std::path::PathBuf;
+
+use clap::{Parser, ValueEnum};
+use raylab_bench::args::{KdArgs, MethodArgs, SceneArgs, in_range, parse_positive};
+use raylab_core::render::{FrameView, RayOrder};
+
+use crate::settings::{RenderMode, Shadows};
+
+/// raylab: fly through a scene traced on the CPU, switch traversal methods live and read what they cost.
+#[derive(Parser, Debug)]
+#[command(name = "raylab", version, about)]
+pub struct Cli {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub kd: KdArgs,
+    #[command(flatten)]
+    pub method: MethodArgs,
+    /// Shadow technique.
+    #[arg(long, value_enum, default_value_t = Shadows::Hard)]
+    pub shadows: Shadows,
+    /// Render mode.
+    #[arg(long, value_enum, default_value_t = RenderMode::Whitted)]
+    pub mode: RenderMode,
+    /// Pixel order inside a tile (single-ray methods): scanline, morton or hilbert.
+    #[arg(long, default_value = "scanline")]
+    pub order: RayOrder,
+    /// What the traced image shows: shaded, nodes, isects, normals or depth.
+    #[arg(long, default_value = "shaded")]
+    pub show: FrameView,
+    /// Count at the hot end of the heat maps (default: each frame's maximum).
+    #[arg(long, value_parser = parse_positive)]
+    pub heat_max: Option<f32>,
+    /// Render resolution in percent of the window, 25 to 100.
+    #[arg(long, default_value_t = 100, value_parser = in_range(25, 100))]
+    pub scale: u64,
+    /// Tracer threads (default: all CPUs).
+    #[arg(long, value_parser = in_range(1, 1024))]
+    pub threads: Option<u64>,
+    /// Window (or offscreen image) width in pixels.
+    #[arg(long, default_value_t = 1280, value_parser = in_range(16, 8192))]
+    pub width: u64,
+    /// Window (or offscreen image) height in pixels.
+    #[arg(long, default_value_t = 720, value_parser = in_range(16, 8192))]
+    pub height: u64,
+    /// Start with the side panel hidden (Tab toggles it).
+    #[arg(long)]
+    pub no_panel: bool,
+    /// Play this camera path (JSON, as saved by the viewer) from the start.
+    #[arg(long)]
+    pub play: Option<PathBuf>,
+    /// Render this many traced frames, then exit (0 when all went well).
+    #[arg(long, value_parser = in_range(1, 100_000))]
+    pub frames: Option<u64>,
+    /// With --frames: save the whole window (panel included) as PNG before exiting.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// With --frames: save the last traced frame alone as PNG before exiting.
+    #[arg(long)]
+    pub traced_screenshot: Option<PathBuf>,
+    /// With --frames: write the readouts (frame times, counters, stage times, panel rectangle) as JSON.
+    #[arg(long)]
+    pub json_stats: Option<PathBuf>,
+    /// Render offscreen, without a window system (needs --frames).
+    #[arg(long)]
+    pub headless: bool,
+}
+
+impl Cli {
+    /// Checks the combinations clap cannot; the error names the flags.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.frames.is_none() {
+            for (given, flag) in [
+                (self.screenshot.is_some(), "--screenshot"),
+                (self.traced_screenshot.is_some(), "--traced-screenshot"),
+                (self.json_stats.is_some(), "--json-stats"),
+                (self.headless, "--headless"),
+            ] {
+                if given {
+                    return Err(format!("{flag} needs --frames N (how many traced frames to render first)"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Tracer threads: the flag or every CPU.
+    pub fn thread_count(&self) -> usize {
+        self.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize)
+    }
+}
+
+/// `ValueEnum` names for the menus and the command line are the same strings.
+pub fn value_name<T: ValueEnum>(v: &T) -> String {
+    v.to_possible_value().map(|p| p.get_name().to_string()).unwrap_or_default()
+}

@@ -1,0 +1,164 @@
+//! One UI frame, the same for the window and the headless run: advance the lab, upload a newly traced
+//! frame, run egui, and draw everything into a target; plus the automation that ends a `--frames` run.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use crate::capture::capture;
+use crate::compositor::Compositor;
+use crate::gpu::Gpu;
+use crate::lab::{Lab, StatsReport};
+
+/// The GPU side of the viewer.
+pub struct Frontend {
+    /// Device and queue.
+    pub gpu: Gpu,
+    /// Pipelines and the frame texture.
+    pub compositor: Compositor,
+    /// egui's context.
+    pub egui: egui::Context,
+    last_tick: Instant,
+}
+
+/// A UI frame ready to draw.
+pub struct UiFrame {
+    jobs: Vec<egui::ClippedPrimitive>,
+    screen: egui_wgpu::ScreenDescriptor,
+    free: Vec<egui::TextureId>,
+    /// What egui asks of the window system (cursor, clipboard, links).
+    pub platform: egui::PlatformOutput,
+    /// When egui wants the next frame (`Duration::ZERO`: at once; `Duration::MAX`: only on input).
+    pub repaint_delay: Duration,
+    /// CPU time of the frame upload, when a new traced frame was uploaded.
+    pub upload_ms: Option<f64>,
+    started: Instant,
+}
+
+impl Frontend {
+    /// The GPU side for targets of `format`.
+    pub fn new(gpu: Gpu, format: wgpu::TextureFormat) -> Self {
+        let compositor = Compositor::new(&gpu.device, format);
+        Self { gpu, compositor, egui: egui::Context::default(), last_tick: Instant::now() }
+    }
+
+    /// Advances `lab`, uploads its newest traced frame and runs the UI for a target of `size` pixels.
+    pub fn build(&mut self, lab: &mut Lab, raw: egui::RawInput, size: (u32, u32), ppp: f32) -> UiFrame {
+        let started = Instant::now();
+        let dt = started.duration_since(self.last_tick).as_secs_f32();
+        self.last_tick = started;
+        lab.set_window_size(size.0, size.1);
+        lab.tick(dt);
+        let upload_ms = lab.poll().map(|r| {
+            let f = &r.frame;
+            let d = self.compositor.upload(&self.gpu.device, &self.gpu.queue, f.width, f.height, &f.rgba);
+            d.as_secs_f64() * 1e3
+        });
+        let out = self.egui.run_ui(raw, |ui| lab.ui(ui));
+        let jobs = self.egui.tessellate(out.shapes, out.pixels_per_point);
+        let free = self.compositor.apply_egui_textures(&self.gpu.device, &self.gpu.queue, out.textures_delta);
+        let repaint_delay = out.viewport_output.get(&egui::ViewportId::ROOT).map_or(Duration::MAX, |v| v.repaint_delay);
+        UiFrame {
+            jobs,
+            screen: egui_wgpu::ScreenDescriptor { size_in_pixels: [size.0, size.1], pixels_per_point: ppp },
+            free,
+            platform: out.platform_output,
+            repaint_delay,
+            upload_ms,
+            started,
+        }
+    }
+
+    /// Draws `frame` into `target` (of `size` pixels) and submits it.
+    pub fn draw(&mut self, frame: &UiFrame, target: &wgpu::TextureView, size: (u32, u32)) {
+        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ui") });
+        let extra = self.compositor.prepare_egui(device, queue, &mut encoder, &frame.jobs, &frame.screen);
+        self.compositor.draw(queue, &mut encoder, target, size, &frame.jobs, &frame.screen);
+        queue.submit(extra.into_iter().chain([encoder.finish()]));
+    }
+
+    /// Saves the window shots `lab` asked for, then lets egui free what it no longer needs, and records the
+    /// UI frame's cost.
+    pub fn finish(&mut self, lab: &mut Lab, frame: UiFrame) {
+        let ui_ms = frame.started.elapsed().as_secs_f64() * 1e3 - frame.upload_ms.unwrap_or(0.0);
+        for path in lab.take_window_shots() {
+            match self.screenshot(&frame, &path) {
+                Ok(()) => lab.message(format!("saved the window to {}", path.display()), false),
+                Err(e) => lab.message(e, true),
+            }
+        }
+        self.compositor.free_egui(&frame.free);
+        lab.readouts.push_ui(frame.upload_ms, ui_ms);
+    }
+
+    /// Draws `frame` offscreen and writes it as PNG.
+    pub fn screenshot(&self, frame: &UiFrame, path: &std::path::Path) -> Result<(), String> {
+        let size = (frame.screen.size_in_pixels[0], frame.screen.size_in_pixels[1]);
+        let img = capture(&self.gpu.device, &self.gpu.queue, &self.compositor, size, &frame.jobs, &frame.screen)?;
+        img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    }
+}
+
+/// What a `--frames N` run does at the end.
+pub struct Automation {
+    /// Traced frames to wait for.
+    pub frames: u64,
+    /// Whole-window screenshot file.
+    pub screenshot: Option<PathBuf>,
+    /// Traced-frame screenshot file.
+    pub traced_screenshot: Option<PathBuf>,
+    /// Readouts file.
+    pub json_stats: Option<PathBuf>,
+}
+
+/// The `--json-stats` file.
+#[derive(Serialize)]
+struct StatsFile<'a> {
+    scene: &'a str,
+    triangles: usize,
+    gpu: &'a str,
+    window: [u32; 2],
+    render: [u32; 2],
+    settings: crate::settings::SettingsReport,
+    /// The side panel's rectangle in pixels (x0, y0, x1, y1), or null when hidden.
+    panel_rect: Option<[f32; 4]>,
+    /// Everything the UI drew over the traced image (the panel first), in pixels.
+    ui_rects: &'a [[f32; 4]],
+    readouts: StatsReport,
+}
+
+impl Automation {
+    /// True once enough frames were traced and the last one is on screen (it was uploaded by `frame`).
+    pub fn due(&self, lab: &Lab, frame: &UiFrame) -> bool {
+        lab.readouts.frames() as u64 >= self.frames && frame.upload_ms.is_some()
+    }
+
+    /// Writes the requested outputs from `frame`; the error names the file.
+    pub fn finish(&self, front: &Frontend, lab: &Lab, frame: &UiFrame) -> Result<(), String> {
+        if let Some(p) = &self.screenshot {
+            front.screenshot(frame, p)?;
+        }
+        if let Some(p) = &self.traced_screenshot {
+            lab.save_traced(p)?;
+        }
+        if let Some(p) = &self.json_stats {
+            let latest = lab.latest().ok_or("no frame was traced")?;
+            let file = StatsFile {
+                scene: &lab.scene().name,
+                triangles: lab.scene().scene.triangle_count(),
+                gpu: &lab.gpu_name,
+                window: frame.screen.size_in_pixels,
+                render: [latest.frame.width, latest.frame.height],
+                settings: latest.settings.report(),
+                panel_rect: lab.panel_rect,
+                ui_rects: &lab.ui_rects,
+                readouts: lab.readouts.report(),
+            };
+            let json = serde_json::to_string_pretty(&file).map_err(|e| e.to_string())?;
+            std::fs::write(p, json).map_err(|e| format!("cannot write {}: {e}", p.display()))?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,486 @@
+//! The lab: the state behind the window (scene, camera, settings, worker, readouts) and the egui panels that
+//! change it. It knows nothing about winit or the GPU, so the windowed and the headless runs share it.
+
+mod bookmarks;
+mod compare_table;
+mod panel;
+mod readouts;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use raylab_bench::args::SceneArgs;
+use raylab_core::kdtree::KdParams;
+use raylab_core::scene::PointLight;
+
+use crate::camera_path::{CameraPath, Player, Recorder};
+use crate::fly::{FlyCamera, MoveKeys};
+use crate::loader::{LoadPoll, LoadedScene, PendingLoad};
+use crate::settings::ViewerSettings;
+use crate::worker::{Job, Rendered, Worker, WorkerEvent};
+pub use bookmarks::Bookmarks;
+use compare_table::CompareTable;
+pub use readouts::{Readouts, StatsReport};
+
+/// How long a message stays on screen.
+const MESSAGE_TIME: Duration = Duration::from_secs(8);
+
+/// A line shown at the bottom of the window.
+struct Message {
+    text: String,
+    error: bool,
+    at: Instant,
+}
+
+/// What a screenshot request captures.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Shot {
+    /// The whole window, panels included, to this file.
+    Window(PathBuf),
+    /// The traced frame alone, to this file.
+    Traced(PathBuf),
+}
+
+/// The viewer's state.
+pub struct Lab {
+    scene: Arc<LoadedScene>,
+    kd: KdParams,
+    /// The settings the next frame is traced with.
+    pub settings: ViewerSettings,
+    fly: FlyCamera,
+    light: PointLight,
+    worker: Worker,
+    wake: Arc<dyn Fn() + Send + Sync>,
+    loading: Option<PendingLoad>,
+    messages: Vec<Message>,
+    latest: Option<Box<Rendered>>,
+    fresh: bool,
+    /// Frame times and counters.
+    pub readouts: Readouts,
+    compare: CompareTable,
+    bookmarks: Bookmarks,
+    recorder: Option<Recorder>,
+    player: Option<Player>,
+    keys: MoveKeys,
+    /// Whether the side panel is shown.
+    pub panel_visible: bool,
+    window: (u32, u32),
+    dirty: bool,
+    shots: Vec<Shot>,
+    /// Where the side panel was drawn in the last UI frame, in pixels (for tests and the stats file).
+    pub panel_rect: Option<[f32; 4]>,
+    /// Rectangles of everything egui drew over the traced image in the last UI frame (the panel, the
+    /// overlays and windows), in pixels, without their drop shadows.
+    pub ui_rects: Vec<[f32; 4]>,
+    /// The GPU in use, shown in the panel.
+    pub gpu_name: String,
+    open_path: String,
+    new_bookmark: String,
+    path_file: String,
+    file_dialog: Option<egui_file::FileDialog>,
+}
+
+/// A file name in the working directory with the current time in it, for screenshots.
+pub fn timestamped(stem: &str) -> PathBuf {
+    let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
+    PathBuf::from(format!("{stem}-{secs}.png"))
+}
+
+/// Scene files the Open dialog lists.
+fn is_scene_file(p: &std::path::Path) -> bool {
+    p.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+}
+
+impl Lab {
+    /// A lab showing `scene`; `wake` is called from other threads when a frame or a load is ready.
+    pub fn new(scene: LoadedScene, kd: KdParams, settings: ViewerSettings, wake: Arc<dyn Fn() + Send + Sync>) -> Self {
+        let w = Arc::clone(&wake);
+        let worker = Worker::start(move || w());
+        let fly = FlyCamera::new(scene.camera, &scene.scene.bounds());
+        let light = scene.light;
+        let bookmarks = Bookmarks::load();
+        Self {
+            scene: Arc::new(scene),
+            kd,
+            settings,
+            fly,
+            light,
+            worker,
+            wake,
+            loading: None,
+            messages: Vec::new(),
+            latest: None,
+            fresh: false,
+            readouts: Readouts::default(),
+            compare: CompareTable::default(),
+            bookmarks,
+            recorder: None,
+            player: None,
+            keys: MoveKeys::default(),
+            panel_visible: true,
+            window: (1, 1),
+            dirty: true,
+            shots: Vec::new(),
+            panel_rect: None,
+            ui_rects: Vec::new(),
+            gpu_name: String::new(),
+            open_path: String::new(),
+            new_bookmark: String::new(),
+            path_file: "camera-path.json".into(),
+            file_dialog: None,
+        }
+    }
+
+    /// The scene on screen.
+    pub fn scene(&self) -> &LoadedScene {
+        &self.scene
+    }
+
+    /// Tells the lab the window's size in pixels (zero while minimised: nothing is traced then).
+    pub fn set_window_size(&mut self, width: u32, height: u32) {
+        if (width, height) != self.window {
+            self.window = (width, height);
+            self.dirty = true;
+        }
+    }
+
+    /// Shows a message at the bottom of the window (and on stderr when it is an error).
+    pub fn message(&mut self, text: impl Into<String>, error: bool) {
+        let text = text.into();
+        if error {
+            eprintln!("raylab: {text}");
+        }
+        self.messages.push(Message { text, error, at: Instant::now() });
+    }
+
+    /// Presses or releases a movement key.
+    pub fn set_keys(&mut self, f: impl FnOnce(&mut MoveKeys)) {
+        f(&mut self.keys);
+    }
+
+    /// Releases every movement key (when the window loses focus).
+    pub fn release_keys(&mut self) {
+        self.keys = MoveKeys::default();
+    }
+
+    /// Turns the camera by a mouse motion in pixels.
+    pub fn look(&mut self, dx: f32, dy: f32) {
+        if self.player.is_none() && self.fly.look(dx, dy) {
+            self.dirty = true;
+        }
+    }
+
+    /// Changes the flying speed by wheel lines.
+    pub fn wheel(&mut self, lines: f32) {
+        self.fly.wheel(lines);
+    }
+
+    /// Moves the camera so the whole scene is in view.
+    pub fn frame_scene(&mut self) {
+        if self.fly.frame(&self.scene.scene.bounds()) {
+            self.dirty = true;
+        }
+    }
+
+    /// Asks for a screenshot, saved after the next drawn UI frame.
+    pub fn request_shot(&mut self, shot: Shot) {
+        self.shots.push(shot);
+    }
+
+    /// Screenshot requests of the whole window (the caller draws and saves them); traced-frame requests are
+    /// saved here, from the latest frame.
+    pub fn take_window_shots(&mut self) -> Vec<PathBuf> {
+        let shots = std::mem::take(&mut self.shots);
+        let mut window = Vec::new();
+        for s in shots {
+            match s {
+                Shot::Window(p) => window.push(p),
+                Shot::Traced(p) => match self.save_traced(&p) {
+                    Ok(()) => self.message(format!("saved the traced frame to {}", p.display()), false),
+                    Err(e) => self.message(e, true),
+                },
+            }
+        }
+        window
+    }
+
+    /// Writes the latest traced frame as PNG; the error names the file.
+    pub fn save_traced(&self, path: &std::path::Path) -> Result<(), String> {
+        let r = self.latest.as_ref().ok_or("no frame has been traced yet")?;
+        let f = &r.frame;
+        let img = image::RgbaImage::from_raw(f.width, f.height, f.rgba.as_flattened().to_vec())
+            .ok_or("frame buffer size mismatch")?;
+        img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    }
+
+    /// Starts loading another scene; the current one stays until it is ready.
+    pub fn open(&mut self, scene: &str) {
+        let scene = scene.trim();
+        if scene.is_empty() {
+            return;
+        }
+        let w = Arc::clone(&self.wake);
+        self.loading = Some(PendingLoad::start(SceneArgs::named(scene), self.kd, move || w()));
+        (self.wake)();
+    }
+
+    /// Shows the Open dialog.
+    pub fn open_dialog(&mut self) {
+        let mut d = egui_file::FileDialog::open_file()
+            .title("Open a scene")
+            .show_files_filter(Box::new(is_scene_file))
+            .show_new_folder(false)
+            .show_rename(false);
+        d.open();
+        self.file_dialog = Some(d);
+    }
+
+    /// Starts a comparison of every method and tile size on the current view.
+    pub fn start_compare(&mut self) {
+        let (w, h) = self.window;
+        if w == 0 || h == 0 || self.compare.running() {
+            return;
+        }
+        self.compare.start();
+        self.worker.compare(self.job());
+    }
+
+    /// Shows the error of `r`, if any.
+    fn report(&mut self, r: Result<(), String>) {
+        if let Err(e) = r {
+            self.message(e, true);
+        }
+    }
+
+    /// Ends the recording and saves the path to the panel's file name.
+    fn stop_recording(&mut self) {
+        if let Some(rec) = self.recorder.take() {
+            let file = PathBuf::from(&self.path_file);
+            match rec.finish().save(&file) {
+                Ok(()) => self.message(format!("saved the camera path to {}", file.display()), false),
+                Err(e) => self.message(e, true),
+            }
+        }
+    }
+
+    /// Plays `path` from its start (one key per traced frame).
+    pub fn play(&mut self, path: CameraPath, looping: bool) {
+        self.recorder = None;
+        self.player = Some(Player::new(path, looping));
+        self.advance_player();
+    }
+
+    fn advance_player(&mut self) {
+        let Some(p) = &mut self.player else { return };
+        match p.advance() {
+            Some(c) => {
+                self.fly.camera = c;
+                self.dirty = true;
+            }
+            None => {
+                self.player = None;
+                self.message("camera path finished", false);
+            }
+        }
+    }
+
+    /// Advances time by `dt` seconds: flies the camera with the held keys and records the path.
+    pub fn tick(&mut self, dt: f32) {
+        if self.player.is_none() && self.fly.step(&self.keys, dt) {
+            self.dirty = true;
+        }
+        if let Some(r) = &mut self.recorder {
+            r.tick(self.fly.camera);
+        }
+        self.messages.retain(|m| m.at.elapsed() < MESSAGE_TIME);
+    }
+
+    /// Collects finished frames, comparison rows and loads; returns the newest frame not yet handed out, for
+    /// upload.
+    pub fn poll(&mut self) -> Option<&Rendered> {
+        for ev in self.worker.drain() {
+            match ev {
+                WorkerEvent::Frame(r) => {
+                    self.readouts.push(&r);
+                    self.latest = Some(r);
+                    self.fresh = true;
+                    if self.player.is_some() {
+                        self.advance_player();
+                    }
+                }
+                WorkerEvent::CompareRow(row, total) => self.compare.add(row, total),
+                WorkerEvent::CompareDone => {
+                    self.compare.finish();
+                    self.dirty = true;
+                }
+                WorkerEvent::Error(e) => self.message(e, true),
+            }
+        }
+        if self.compare.take_cancel() {
+            self.worker.cancel_compare();
+        }
+        self.poll_loading();
+        self.submit();
+        if std::mem::take(&mut self.fresh) { self.latest.as_deref() } else { None }
+    }
+
+    /// The latest traced frame.
+    pub fn latest(&self) -> Option<&Rendered> {
+        self.latest.as_deref()
+    }
+
+    /// True while something is in progress that needs the UI to keep redrawing (a load, a comparison,
+    /// continuous tracing, a held key, a playing path).
+    pub fn busy(&self) -> bool {
+        self.loading.is_some()
+            || self.compare.running()
+            || self.settings.continuous
+            || self.keys.any()
+            || self.player.is_some()
+            || !self.messages.is_empty()
+    }
+
+    fn poll_loading(&mut self) {
+        let Some(l) = &self.loading else { return };
+        if let LoadPoll::Done(result) = l.poll() {
+            let what = l.what.clone();
+            self.loading = None;
+            match *result {
+                Ok(s) => {
+                    self.message(
+                        format!(
+                            "loaded {}: {} triangles in {:.2} s (kd-tree {:.2} s)",
+                            s.name,
+                            s.scene.triangle_count(),
+                            s.load_s,
+                            s.build_s
+                        ),
+                        false,
+                    );
+                    self.fly = FlyCamera::new(s.camera, &s.scene.bounds());
+                    self.light = s.light;
+                    self.scene = Arc::new(s);
+                    self.player = None;
+                    self.recorder = None;
+                    self.dirty = true;
+                }
+                Err(e) => self.message(format!("could not open {what}: {e} (the current scene stays)"), true),
+            }
+        }
+    }
+
+    /// Sends the current view to the worker when it changed.
+    fn submit(&mut self) {
+        let (w, h) = self.window;
+        if !self.dirty || w == 0 || h == 0 || self.compare.running() {
+            return;
+        }
+        self.dirty = false;
+        self.worker.request(self.job());
+    }
+
+    fn job(&self) -> Job {
+        let mut settings = self.settings;
+        // A playing path asks for each frame itself.
+        settings.continuous &= self.player.is_none();
+        Job {
+            scene: Arc::clone(&self.scene),
+            camera: self.fly.camera,
+            light: self.light,
+            settings,
+            size: settings.render_size(self.window.0, self.window.1),
+        }
+    }
+
+    /// Draws the panels and overlays into `ui` (the whole window).
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        self.panel_rect = None;
+        let ppp = ui.ctx().pixels_per_point();
+        let px = |r: egui::Rect| [r.min.x * ppp, r.min.y * ppp, r.max.x * ppp, r.max.y * ppp];
+        if self.panel_visible {
+            let r = egui::Panel::left("controls")
+                .resizable(true)
+                .default_size(300.0)
+                .show(ui, |ui| egui::ScrollArea::vertical().show(ui, |ui| panel::show(self, ui)))
+                .response
+                .rect;
+            self.panel_rect = Some(px(r));
+        }
+        let mut rects: Vec<egui::Rect> = self.overlays(ui);
+        let ctx = ui.ctx().clone();
+        rects.extend(self.compare.window(&ctx));
+        if let Some(d) = &mut self.file_dialog {
+            d.show(&ctx);
+            let chosen = d.selected().then(|| d.path().map(|p| p.display().to_string())).flatten();
+            if d.visible() {
+                // The dialog is a window that may cover the image anywhere; count all of it.
+                rects.push(ctx.content_rect());
+            } else {
+                self.file_dialog = None;
+            }
+            if let Some(p) = chosen {
+                self.open_path.clone_from(&p);
+                self.open(&p);
+            }
+        }
+        self.ui_rects = self.panel_rect.into_iter().chain(rects.into_iter().map(px)).collect();
+    }
+
+    /// The FPS corner, the heat-map legend and the message lines; returns the rectangles they cover.
+    fn overlays(&mut self, ui: &mut egui::Ui) -> Vec<egui::Rect> {
+        let ctx = ui.ctx().clone();
+        let mut rects = Vec::new();
+        let r = egui::Area::new(egui::Id::unique("fps"))
+            .anchor(egui::Align2::RIGHT_TOP, egui::vec2(-8.0, 8.0))
+            .interactable(false)
+            .show(&ctx, |ui| {
+                egui::Frame::popup(ui.style()).show(ui, |ui| self.readouts.corner(ui, self.latest.as_deref()));
+            });
+        rects.push(r.response.rect);
+        if let Some(r) = &self.latest
+            && let Some(range) = r.frame.range
+        {
+            let r = egui::Area::new(egui::Id::unique("legend"))
+                .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-8.0, -8.0))
+                .interactable(false)
+                .show(&ctx, |ui| {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| readouts::legend(ui, r.settings.show, range));
+                });
+            rects.push(r.response.rect);
+        }
+        let loading = self.loading.as_ref().map(|l| {
+            let (stage, t) = l.stage();
+            format!("{}: {stage}... {:.1} s", l.what, t.as_secs_f32())
+        });
+        let status: Vec<(String, Option<bool>)> = loading
+            .into_iter()
+            .map(|t| (t, None))
+            .chain(self.messages.iter().map(|m| (m.text.clone(), Some(m.error))))
+            .collect();
+        if !status.is_empty() {
+            let r = egui::Area::new(egui::Id::unique("messages"))
+                .anchor(egui::Align2::CENTER_BOTTOM, egui::vec2(0.0, -8.0))
+                .interactable(false)
+                .show(&ctx, |ui| {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        for (text, error) in status {
+                            match error {
+                                Some(true) => ui.colored_label(ui.visuals().error_fg_color, text),
+                                Some(false) => ui.label(text),
+                                None => {
+                                    ui.horizontal(|ui| {
+                                        ui.spinner();
+                                        ui.label(text);
+                                    })
+                                    .response
+                                }
+                            };
+                        }
+                    });
+                });
+            rects.push(r.response.rect);
+        }
+        rects
+    }
+}

@@ -1,0 +1,237 @@
+//! The side panel: every switch of the tracer, grouped as a user reaches for them (scene, camera, rendering,
+//! view), with the readouts below.
+
+use raylab_core::method::Method;
+use raylab_core::render::{FrameView, RayOrder};
+use raylab_simd::Backend;
+
+use super::{Lab, Shot};
+use crate::camera_path::CameraPath;
+use crate::cli::value_name;
+use crate::settings::{RenderMode, Shadows, ViewerSettings};
+
+/// Draws the panel.
+pub fn show(lab: &mut Lab, ui: &mut egui::Ui) {
+    ui.heading("raylab");
+    scene_section(lab, ui);
+    camera_section(lab, ui);
+    render_section(lab, ui);
+    view_section(lab, ui);
+    egui::CollapsingHeader::new("Readouts").default_open(true).show(ui, |ui| lab.readouts.panel(ui));
+    ui.separator();
+    ui.horizontal(|ui| {
+        if ui.button("Compare methods").on_hover_text("Trace this view with every method and tile size").clicked() {
+            lab.start_compare();
+        }
+        if ui.button("Save frame").on_hover_text("The traced frame as PNG").clicked() {
+            lab.request_shot(Shot::Traced(super::timestamped("raylab-frame")));
+        }
+        if ui.button("Save window").on_hover_text("The whole window as PNG (F12)").clicked() {
+            lab.request_shot(Shot::Window(super::timestamped("raylab-window")));
+        }
+    });
+    ui.small(format!("GPU: {}", lab.gpu_name));
+    ui.small("Tab hides this panel");
+}
+
+fn scene_section(lab: &mut Lab, ui: &mut egui::Ui) {
+    egui::CollapsingHeader::new("Scene").default_open(true).show(ui, |ui| {
+        let current = lab.scene.name.clone();
+        egui::ComboBox::from_label("built-in").selected_text(&current).show_ui(ui, |ui| {
+            for name in raylab_scene::builtin::names() {
+                if ui.selectable_label(current == name, name).clicked() && current != name {
+                    lab.open(name);
+                }
+            }
+        });
+        ui.horizontal(|ui| {
+            if ui.button("Open...").clicked() {
+                lab.open_dialog();
+            }
+            ui.add(egui::TextEdit::singleline(&mut lab.open_path).hint_text("path/to/scene.obj").desired_width(170.0));
+            if ui.button("Load").clicked() {
+                let p = lab.open_path.clone();
+                lab.open(&p);
+            }
+        });
+        ui.small("or drop an .obj file on the window");
+        let s = &lab.scene;
+        ui.label(format!(
+            "{} triangles, {} kd nodes (depth {}), built in {:.2} s",
+            s.scene.triangle_count(),
+            s.kd_stats.nodes,
+            s.kd_stats.max_depth,
+            s.build_s
+        ));
+        let dropped = s.scene.dropped.total();
+        if dropped > 0 {
+            ui.colored_label(ui.visuals().warn_fg_color, format!("{dropped} bad triangles dropped at load"));
+        }
+    });
+}
+
+fn camera_section(lab: &mut Lab, ui: &mut egui::Ui) {
+    egui::CollapsingHeader::new("Camera").default_open(false).show(ui, |ui| {
+        ui.small("WASD move, Q/E down/up, right drag look, wheel speed, Shift fast, F frame scene");
+        ui.horizontal(|ui| {
+            ui.label("speed");
+            let step = lab.fly.speed * 0.01;
+            ui.add(egui::DragValue::new(&mut lab.fly.speed).speed(step).range(1e-4..=1e7));
+            if ui.button("Frame scene").clicked() {
+                lab.frame_scene();
+            }
+        });
+        ui.label("Bookmarks");
+        let mut go = None;
+        for v in &lab.scene.scene.views {
+            if ui.button(format!("view: {}", v.name)).clicked() {
+                go = Some(v.camera);
+            }
+        }
+        let mut remove = None;
+        for (i, b) in lab.bookmarks.for_scene(&lab.scene.name).iter().enumerate() {
+            ui.horizontal(|ui| {
+                if ui.button(&b.name).clicked() {
+                    go = Some(b.camera);
+                }
+                if ui.small_button("x").on_hover_text("Delete this bookmark").clicked() {
+                    remove = Some(i);
+                }
+            });
+        }
+        if let Some(c) = go {
+            lab.fly.camera = c;
+            lab.dirty = true;
+        }
+        if let Some(i) = remove {
+            let r = lab.bookmarks.remove(&lab.scene.name, i);
+            lab.report(r);
+        }
+        ui.horizontal(|ui| {
+            ui.add(egui::TextEdit::singleline(&mut lab.new_bookmark).hint_text("name").desired_width(120.0));
+            if ui.button("Save view").clicked() {
+                let name = if lab.new_bookmark.trim().is_empty() {
+                    format!("view {}", lab.bookmarks.for_scene(&lab.scene.name).len() + 1)
+                } else {
+                    lab.new_bookmark.trim().to_string()
+                };
+                let r = lab.bookmarks.add(&lab.scene.name, name, lab.fly.camera);
+                lab.report(r);
+                lab.new_bookmark.clear();
+            }
+        });
+        ui.label("Camera path");
+        ui.add(egui::TextEdit::singleline(&mut lab.path_file).desired_width(200.0));
+        ui.horizontal(|ui| {
+            if let Some(rec) = &lab.recorder {
+                if ui.button(format!("Stop ({} keys) and save", rec.len())).clicked() {
+                    lab.stop_recording();
+                }
+            } else if ui.add_enabled(lab.player.is_none(), egui::Button::new("Record")).clicked() {
+                lab.recorder = Some(crate::camera_path::Recorder::start(&lab.scene.name, lab.fly.camera));
+            }
+            if let Some(p) = &lab.player {
+                let (i, n) = p.progress();
+                if ui.button(format!("Stop playback ({i}/{n})")).clicked() {
+                    lab.player = None;
+                    lab.dirty = true;
+                }
+            } else if ui.add_enabled(lab.recorder.is_none(), egui::Button::new("Play")).clicked() {
+                match CameraPath::load(std::path::Path::new(&lab.path_file)) {
+                    Ok(p) => lab.play(p, false),
+                    Err(e) => lab.message(e, true),
+                }
+            }
+        });
+    });
+}
+
+fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
+    let before = lab.settings;
+    let s = &mut lab.settings;
+    egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| {
+        egui::ComboBox::from_label("mode").selected_text(value_name(&s.mode)).show_ui(ui, |ui| {
+            ui.selectable_value(&mut s.mode, RenderMode::Whitted, "whitted");
+        });
+        let probe = *s;
+        egui::ComboBox::from_label("method").selected_text(s.trace.method.name()).show_ui(ui, |ui| {
+            for m in Method::ALL {
+                let why = probe.method_unavailable(m);
+                let r = ui.add_enabled(why.is_none(), egui::Button::selectable(s.trace.method == m, m.name()));
+                if r.clicked() {
+                    s.trace.method = m;
+                }
+                if let Some(why) = why {
+                    r.on_disabled_hover_text(why);
+                }
+            }
+        });
+        egui::ComboBox::from_label("tile").selected_text(format!("{0}x{0}", s.tile)).show_ui(ui, |ui| {
+            for t in ViewerSettings::TILES {
+                ui.selectable_value(&mut s.tile, t, format!("{t}x{t}"));
+            }
+        });
+        let frustums = s.trace.method.uses_tiles();
+        ui.add_enabled(frustums, egui::Checkbox::new(&mut s.trace.cull, "packet/leaf culling"))
+            .on_disabled_hover_text("only the frustum methods cull packets at leaves");
+        egui::ComboBox::from_label("SIMD").selected_text(s.trace.backend.name()).show_ui(ui, |ui| {
+            for b in Backend::available() {
+                ui.selectable_value(&mut s.trace.backend, b, b.name());
+            }
+        });
+        egui::ComboBox::from_label("shadows").selected_text(value_name(&s.shadows)).show_ui(ui, |ui| {
+            ui.selectable_value(&mut s.shadows, Shadows::None, "none");
+            ui.selectable_value(&mut s.shadows, Shadows::Hard, "hard");
+        });
+        ui.add_enabled(
+            frustums && s.shadows == Shadows::Hard,
+            egui::Slider::new(&mut s.trace.shadow_spread_limit, 0.0..=0.5).text("shadow spread limit"),
+        )
+        .on_hover_text("widest shadow bundle traced as a frustum; wider ones go as 2x2 packets");
+        let single = !s.trace.method.uses_packets();
+        ui.add_enabled_ui(single, |ui| {
+            egui::ComboBox::from_label("ray order").selected_text(s.order.name()).show_ui(ui, |ui| {
+                for o in RayOrder::ALL {
+                    ui.selectable_value(&mut s.order, o, o.name());
+                }
+            });
+        })
+        .response
+        .on_disabled_hover_text("packet methods trace tiles row by row");
+        let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+        ui.add(egui::Slider::new(&mut s.threads, 1..=(2 * cpus).max(2)).text("threads"));
+        ui.add(egui::Slider::new(&mut s.scale, 25..=100).text("render scale %"));
+        ui.checkbox(&mut s.continuous, "trace continuously").on_hover_text("keep tracing a still view for steady FPS");
+    });
+    if lab.settings != before {
+        lab.dirty = true;
+    }
+}
+
+fn view_section(lab: &mut Lab, ui: &mut egui::Ui) {
+    let before = lab.settings;
+    let s = &mut lab.settings;
+    egui::CollapsingHeader::new("View").default_open(true).show(ui, |ui| {
+        ui.horizontal_wrapped(|ui| {
+            for v in FrameView::ALL {
+                ui.selectable_value(&mut s.show, v, v.name());
+            }
+        });
+        if s.show.is_heat_map() {
+            let mut fixed = s.heat_max.is_some();
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut fixed, "fixed scale");
+                if fixed {
+                    let mut m = s.heat_max.unwrap_or(64.0);
+                    ui.add(egui::DragValue::new(&mut m).range(0.01..=1e6).speed(0.5));
+                    s.heat_max = Some(m);
+                } else {
+                    s.heat_max = None;
+                }
+            });
+        }
+    });
+    if lab.settings != before {
+        lab.dirty = true;
+    }
+}

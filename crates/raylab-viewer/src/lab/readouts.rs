@@ -1,0 +1,256 @@
+//! The numbers on screen: FPS, frame time, Mrays/s, the thesis's N and I, culled packets, stage times, the
+//! GPU-side costs, and time series of the last seconds; also the JSON report `--json-stats` writes.
+
+use std::collections::VecDeque;
+use std::time::Instant;
+
+use egui_plot::{Legend, Line, Plot, PlotPoints};
+use raylab_core::render::{FrameView, StageTimes, heat_color};
+use raylab_core::stats::TraversalStats;
+use serde::Serialize;
+
+use crate::worker::Rendered;
+
+/// Seconds of history the plots show.
+const HISTORY_S: f64 = 20.0;
+
+/// One traced frame, as the plots remember it.
+#[derive(Clone, Copy, Debug)]
+struct Sample {
+    t: f64,
+    ms: f64,
+    n: f64,
+    i: f64,
+}
+
+/// Running readouts.
+pub struct Readouts {
+    started: Instant,
+    history: VecDeque<Sample>,
+    /// Wall time of every frame traced so far, in milliseconds.
+    frame_ms: Vec<f64>,
+    /// Counters summed over every frame.
+    totals: TraversalStats,
+    stages: StageTimes,
+    last: Option<(TraversalStats, StageTimes, f64)>,
+    upload_ms: Vec<f64>,
+    ui_ms: Vec<f64>,
+    ui_frames: VecDeque<Instant>,
+}
+
+impl Default for Readouts {
+    fn default() -> Self {
+        Self {
+            started: Instant::now(),
+            history: VecDeque::new(),
+            frame_ms: Vec::new(),
+            totals: TraversalStats::default(),
+            stages: StageTimes::default(),
+            last: None,
+            upload_ms: Vec::new(),
+            ui_ms: Vec::new(),
+            ui_frames: VecDeque::new(),
+        }
+    }
+}
+
+/// Culled share of packet visits to leaves, in percent.
+fn culled_pct(s: &TraversalStats) -> f64 {
+    let visits = s.packets_culled + s.packets_tested;
+    if visits == 0 { 0.0 } else { 100.0 * s.packets_culled as f64 / visits as f64 }
+}
+
+impl Readouts {
+    /// Adds a traced frame.
+    pub fn push(&mut self, r: &Rendered) {
+        let s = r.frame.stats;
+        let ms = r.wall_s * 1e3;
+        self.history.push_back(Sample {
+            t: self.started.elapsed().as_secs_f64(),
+            ms,
+            n: s.nodes_per_packet(),
+            i: s.isects_per_packet(),
+        });
+        let now = self.started.elapsed().as_secs_f64();
+        while self.history.front().is_some_and(|x| now - x.t > HISTORY_S) {
+            self.history.pop_front();
+        }
+        self.frame_ms.push(ms);
+        self.totals += s;
+        self.stages += r.frame.stages;
+        self.last = Some((s, r.frame.stages, r.wall_s));
+    }
+
+    /// Records the GPU-side cost of a UI frame: uploading a traced frame (when one was) and building and
+    /// submitting the UI, in milliseconds.
+    pub fn push_ui(&mut self, upload_ms: Option<f64>, ui_ms: f64) {
+        if let Some(u) = upload_ms {
+            self.upload_ms.push(u);
+        }
+        self.ui_ms.push(ui_ms);
+        let now = Instant::now();
+        self.ui_frames.push_back(now);
+        while self.ui_frames.front().is_some_and(|t| now.duration_since(*t).as_secs_f64() > 1.0) {
+            self.ui_frames.pop_front();
+        }
+    }
+
+    /// Traced frames so far.
+    pub fn frames(&self) -> usize {
+        self.frame_ms.len()
+    }
+
+    /// UI frames drawn in the last second.
+    pub fn ui_fps(&self) -> usize {
+        self.ui_frames.len()
+    }
+
+    /// The top-right corner: FPS and frame time.
+    pub fn corner(&self, ui: &mut egui::Ui, latest: Option<&Rendered>) {
+        match latest {
+            Some(r) => {
+                let ms = r.wall_s * 1e3;
+                ui.monospace(format!("{:6.1} FPS  {:7.2} ms", 1e3 / ms.max(1e-6), ms));
+                ui.monospace(format!(
+                    "{} {}x{}  {}x{} px",
+                    r.settings.trace.method, r.settings.tile, r.settings.tile, r.frame.width, r.frame.height
+                ));
+            }
+            None => {
+                ui.monospace("tracing the first frame...");
+            }
+        }
+        ui.monospace(format!("UI {:3} FPS", self.ui_fps()));
+    }
+
+    /// The readouts section of the panel.
+    pub fn panel(&self, ui: &mut egui::Ui) {
+        let Some((s, st, wall)) = self.last else {
+            ui.label("no frame yet");
+            return;
+        };
+        egui::Grid::new("readouts").num_columns(2).striped(true).show(ui, |ui| {
+            let mut row = |k: &str, v: String| {
+                ui.label(k);
+                ui.monospace(v);
+                ui.end_row();
+            };
+            row("FPS", format!("{:.1}", 1.0 / wall.max(1e-9)));
+            row("frame", format!("{:.2} ms", wall * 1e3));
+            row("Mrays/s", format!("{:.2}", s.rays as f64 / wall.max(1e-9) / 1e6));
+            row("rays/frame", format!("{}", s.rays));
+            row("N (nodes/packet)", format!("{:.2}", s.nodes_per_packet()));
+            row("I (isects/packet)", format!("{:.2}", s.isects_per_packet()));
+            row("packets culled", format!("{:.1} %", culled_pct(&s)));
+            let pct = st.percentages();
+            row("primary rays", format!("{:.2} ms ({:.0} %)", st.primary * 1e3, pct[0]));
+            row("shadow rays", format!("{:.2} ms ({:.0} %)", st.shadow * 1e3, pct[1]));
+            row("shading", format!("{:.2} ms ({:.0} %)", st.shading * 1e3, pct[2]));
+            row("upload", format!("{:.3} ms", self.upload_ms.last().copied().unwrap_or(0.0)));
+            row("UI", format!("{:.3} ms", self.ui_ms.last().copied().unwrap_or(0.0)));
+        });
+        ui.small("stage times are summed over the tracer threads");
+        let t0 = self.history.back().map_or(0.0, |s| s.t);
+        let series = |f: fn(&Sample) -> f64| -> PlotPoints<'static> {
+            self.history.iter().map(|s| [s.t - t0, f(s)]).collect::<Vec<_>>().into()
+        };
+        Plot::new("frame ms").height(90.0).legend(Legend::default()).allow_scroll(false).show(ui, |p| {
+            p.line(Line::new("frame ms", series(|s| s.ms)));
+        });
+        Plot::new("n and i").height(90.0).legend(Legend::default()).allow_scroll(false).show(ui, |p| {
+            p.line(Line::new("N", series(|s| s.n)));
+            p.line(Line::new("I", series(|s| s.i)));
+        });
+    }
+
+    /// The summary `--json-stats` writes.
+    pub fn report(&self) -> StatsReport {
+        let mut sorted = self.frame_ms.clone();
+        sorted.sort_by(f64::total_cmp);
+        let n = sorted.len().max(1) as f64;
+        let mean = |v: &[f64]| if v.is_empty() { 0.0 } else { v.iter().sum::<f64>() / v.len() as f64 };
+        let total_s: f64 = sorted.iter().sum::<f64>() / 1e3;
+        StatsReport {
+            frames: self.frame_ms.len(),
+            frame_ms_mean: sorted.iter().sum::<f64>() / n,
+            frame_ms_median: sorted.get(sorted.len() / 2).copied().unwrap_or(0.0),
+            frame_ms_min: sorted.first().copied().unwrap_or(0.0),
+            frame_ms_max: sorted.last().copied().unwrap_or(0.0),
+            fps_median: sorted.get(sorted.len() / 2).map_or(0.0, |m| 1e3 / m.max(1e-9)),
+            mrays_per_s: if total_s > 0.0 { self.totals.rays as f64 / total_s / 1e6 } else { 0.0 },
+            rays_per_frame: self.totals.rays as f64 / n,
+            n: self.totals.nodes_per_packet(),
+            i: self.totals.isects_per_packet(),
+            culled_pct: culled_pct(&self.totals),
+            stage_ms_per_frame: [self.stages.primary, self.stages.shadow, self.stages.shading].map(|s| s * 1e3 / n),
+            upload_ms_mean: mean(&self.upload_ms),
+            ui_ms_mean: mean(&self.ui_ms),
+            ui_frames: self.ui_ms.len(),
+        }
+    }
+}
+
+/// Readouts summarised over a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct StatsReport {
+    /// Traced frames.
+    pub frames: usize,
+    /// Mean frame time in ms.
+    pub frame_ms_mean: f64,
+    /// Median frame time in ms.
+    pub frame_ms_median: f64,
+    /// Fastest frame in ms.
+    pub frame_ms_min: f64,
+    /// Slowest frame in ms.
+    pub frame_ms_max: f64,
+    /// FPS at the median frame time.
+    pub fps_median: f64,
+    /// Rays per second over all frames, in millions.
+    pub mrays_per_s: f64,
+    /// Mean rays per frame.
+    pub rays_per_frame: f64,
+    /// Thesis N over all frames.
+    pub n: f64,
+    /// Thesis I over all frames.
+    pub i: f64,
+    /// Culled packet share in percent.
+    pub culled_pct: f64,
+    /// Mean thread-summed ms per frame of the primary, shadow and shading stages.
+    pub stage_ms_per_frame: [f64; 3],
+    /// Mean CPU ms to upload a traced frame.
+    pub upload_ms_mean: f64,
+    /// Mean CPU ms to build, encode and submit a UI frame (the upload excluded).
+    pub ui_ms_mean: f64,
+    /// UI frames drawn.
+    pub ui_frames: usize,
+}
+
+/// The colour scale of a heat map or the depth view.
+pub fn legend(ui: &mut egui::Ui, view: FrameView, (lo, hi): (f32, f32)) {
+    let title = match view {
+        FrameView::Nodes => "kd nodes per pixel",
+        FrameView::Isects => "triangle tests per pixel",
+        FrameView::Depth => "hit distance",
+        _ => return,
+    };
+    ui.label(title);
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(180.0, 14.0), egui::Sense::hover());
+    let steps = 36;
+    for k in 0..steps {
+        let x = k as f32 / (steps - 1) as f32;
+        let c = if view == FrameView::Depth {
+            let g = (255.0 * (1.0 - 0.9 * x).powf(1.0 / 2.2)) as u8;
+            [g, g, g, 255]
+        } else {
+            heat_color(x)
+        };
+        let w = rect.width() / steps as f32;
+        let r = egui::Rect::from_min_size(rect.min + egui::vec2(k as f32 * w, 0.0), egui::vec2(w + 0.5, rect.height()));
+        ui.painter().rect_filled(r, 0.0, egui::Color32::from_rgb(c[0], c[1], c[2]));
+    }
+    ui.horizontal(|ui| {
+        ui.monospace(format!("{lo:.1}"));
+        ui.add_space(110.0);
+        ui.monospace(format!("{hi:.1}"));
+    });
+}

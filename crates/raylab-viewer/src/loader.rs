@@ -1,0 +1,110 @@
+//! Loading a scene and building its kd-tree on a background thread, so the window keeps drawing (and the
+//! current scene stays usable) while a large model loads; a failure leaves the current scene in place.
+
+use std::sync::mpsc::{self, Receiver, TryRecvError};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use raylab_bench::args::SceneArgs;
+use raylab_core::kdtree::{KdParams, KdStats, KdTree};
+use raylab_core::scene::{Camera, PointLight, Scene};
+
+/// A scene ready to trace: the triangles, their kd-tree, and the view and light it opened with.
+pub struct LoadedScene {
+    /// Name shown in the panel: the built-in name or the file name.
+    pub name: String,
+    /// The scene.
+    pub scene: Scene,
+    /// Its kd-tree.
+    pub tree: KdTree,
+    /// The camera the scene opened with (the flags, the scene's default view, or a view of the whole scene).
+    pub camera: Camera,
+    /// The benchmark light.
+    pub light: PointLight,
+    /// Seconds spent loading and building.
+    pub load_s: f64,
+    /// Seconds spent building the kd-tree.
+    pub build_s: f64,
+    /// Size and quality of the tree.
+    pub kd_stats: KdStats,
+}
+
+/// Loads `args`' scene and builds its tree on the calling thread, reporting the stage through `stage`.
+pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Result<LoadedScene, String> {
+    let t0 = Instant::now();
+    stage("loading scene");
+    let scene = raylab_scene::load(&args.source()).map_err(|e| e.to_string())?;
+    let (camera, light) = args.camera_and_light(&scene)?;
+    stage("building kd-tree");
+    let tree = KdTree::build(&scene, params).map_err(|e| format!("{}: {e}", args.scene))?;
+    let name = std::path::Path::new(&args.scene)
+        .file_name()
+        .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
+    Ok(LoadedScene {
+        name,
+        build_s: tree.build_time().as_secs_f64(),
+        kd_stats: tree.stats(),
+        scene,
+        tree,
+        camera,
+        light,
+        load_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// A load running on its own thread.
+pub struct PendingLoad {
+    /// What is being loaded (the scene flag's value).
+    pub what: String,
+    started: Instant,
+    stage: Arc<Mutex<String>>,
+    done: Receiver<Result<LoadedScene, String>>,
+}
+
+/// The state of a [`PendingLoad`] when polled.
+pub enum LoadPoll {
+    /// Still working.
+    Running,
+    /// Finished.
+    Done(Box<Result<LoadedScene, String>>),
+}
+
+impl PendingLoad {
+    /// Starts loading `args` with `params` on a new thread; `wake` is called when it finishes.
+    pub fn start(args: SceneArgs, params: KdParams, wake: impl Fn() + Send + 'static) -> Self {
+        let stage = Arc::new(Mutex::new(String::from("starting")));
+        let (tx, done) = mpsc::channel();
+        let what = args.scene.clone();
+        let st = Arc::clone(&stage);
+        std::thread::spawn(move || {
+            let set = |s: &str| {
+                if let Ok(mut g) = st.lock() {
+                    *g = s.to_string();
+                }
+            };
+            // A panic in a loader must reach the user as an error, not take the viewer down.
+            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_now(&args, &params, &set)))
+                .unwrap_or_else(|_| Err(format!("{}: the loader failed unexpectedly", args.scene)));
+            // The receiver is gone only when the viewer is closing; nothing is left to tell.
+            let _ = tx.send(result);
+            wake();
+        });
+        Self { what, started: Instant::now(), stage, done }
+    }
+
+    /// The current stage and the time so far, without taking the result.
+    pub fn stage(&self) -> (String, Duration) {
+        (self.stage.lock().map(|s| s.clone()).unwrap_or_default(), self.started.elapsed())
+    }
+
+    /// Where the load stands; a finished load hands its result out once.
+    pub fn poll(&self) -> LoadPoll {
+        match self.done.try_recv() {
+            Ok(r) => LoadPoll::Done(Box::new(r)),
+            Err(TryRecvError::Disconnected) => {
+                LoadPoll::Done(Box::new(Err(format!("{}: the loader stopped without a result", self.what))))
+            }
+            Err(TryRecvError::Empty) => LoadPoll::Running,
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! Everything the side panel can change about how frames are traced, in one value that travels to the
+//! render worker with each job.
+
+use clap::ValueEnum;
+use raylab_core::method::Method;
+use raylab_core::render::{FrameView, RayOrder, RenderSettings};
+use raylab_core::trace::TraceOptions;
+use serde::{Deserialize, Serialize};
+
+/// How a frame is made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RenderMode {
+    /// Primary rays and shadow rays with the benchmark shading (Whitted-style, thesis chapter 4).
+    #[default]
+    Whitted,
+}
+
+/// Shadow technique.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Shadows {
+    /// No shadow rays: every surface facing the light is lit.
+    None,
+    /// One any-hit ray per pixel toward the point light, traced with the current method's coherent path.
+    #[default]
+    Hard,
+}
+
+/// The frame settings the UI controls.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewerSettings {
+    /// Render mode.
+    pub mode: RenderMode,
+    /// Traversal method and its switches.
+    pub trace: TraceOptions,
+    /// Tile edge in pixels.
+    pub tile: u32,
+    /// Shadow technique.
+    pub shadows: Shadows,
+    /// Pixel order of single-ray methods.
+    pub order: RayOrder,
+    /// What the traced image shows.
+    pub show: FrameView,
+    /// Fixed hot end of the heat maps, or `None` for each frame's maximum.
+    pub heat_max: Option<f32>,
+    /// Render resolution in percent of the window (25-100).
+    pub scale: u32,
+    /// Tracer threads.
+    pub threads: usize,
+    /// Keep tracing the same view (to read steady FPS) rather than only after a change.
+    pub continuous: bool,
+}
+
+impl ViewerSettings {
+    /// Tile edges offered in the panel (thesis Tables 4.1-4.5 use 4-64).
+    pub const TILES: [u32; 5] = [4, 8, 16, 32, 64];
+
+    /// The render resolution for a window of `width x height` pixels (at least 1x1).
+    pub fn render_size(&self, width: u32, height: u32) -> (u32, u32) {
+        let s = self.scale.clamp(25, 100);
+        ((width * s).div_ceil(100).max(1), (height * s).div_ceil(100).max(1))
+    }
+
+    /// The core renderer's settings for a frame of `width x height` traced pixels.
+    pub fn render_settings(&self, width: u32, height: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            tile: self.tile,
+            order: self.order,
+            shadows: self.shadows == Shadows::Hard,
+            view: self.show,
+            heat_max: self.heat_max,
+        }
+    }
+
+    /// The settings as the stats file records them.
+    pub fn report(&self) -> SettingsReport {
+        SettingsReport {
+            mode: self.mode,
+            method: self.trace.method,
+            tile: self.tile,
+            cull: self.trace.cull,
+            backend: self.trace.backend.name(),
+            shadow_spread_limit: self.trace.shadow_spread_limit,
+            shadows: self.shadows,
+            order: self.order,
+            show: self.show,
+            heat_max: self.heat_max,
+            scale: self.scale,
+            threads: self.threads,
+        }
+    }
+
+    /// Why `method` cannot be chosen in the current mode, if it cannot.
+    pub fn method_unavailable(&self, method: Method) -> Option<&'static str> {
+        match method {
+            Method::Reference => Some("brute force over every triangle: for tests, far too slow to fly with"),
+            _ => None,
+        }
+    }
+}
+
+/// [`ViewerSettings`] as written to the `--json-stats` file.
+#[derive(Clone, Debug, Serialize)]
+pub struct SettingsReport {
+    /// Render mode.
+    pub mode: RenderMode,
+    /// Traversal method.
+    pub method: Method,
+    /// Tile edge.
+    pub tile: u32,
+    /// Packet/leaf culling.
+    pub cull: bool,
+    /// SIMD backend name.
+    pub backend: &'static str,
+    /// Shadow spread limit of the frustum methods.
+    pub shadow_spread_limit: f32,
+    /// Shadow technique.
+    pub shadows: Shadows,
+    /// Ray order.
+    pub order: RayOrder,
+    /// Frame view.
+    pub show: FrameView,
+    /// Fixed heat-map maximum.
+    pub heat_max: Option<f32>,
+    /// Render scale in percent.
+    pub scale: u32,
+    /// Tracer threads.
+    pub threads: usize,
+}

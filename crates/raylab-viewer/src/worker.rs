@@ -1,0 +1,210 @@
+//! The render worker: one thread that owns a rayon pool of the chosen size and traces the latest requested
+//! frame, so the window's event loop never waits for the tracer. Requests replace each other (only the
+//! newest matters); in continuous mode the last view is traced again and again to give steady FPS readings.
+
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::thread::JoinHandle;
+use std::time::Instant;
+
+use raylab_core::method::Method;
+use raylab_core::render::{Frame, render};
+use raylab_core::scene::{Camera, PointLight};
+use raylab_core::trace::Tracer;
+
+use crate::compare::{CompareRow, compare_configs};
+use crate::loader::LoadedScene;
+use crate::settings::ViewerSettings;
+
+/// One frame to trace.
+#[derive(Clone)]
+pub struct Job {
+    /// The scene and its tree.
+    pub scene: Arc<LoadedScene>,
+    /// The camera.
+    pub camera: Camera,
+    /// The light.
+    pub light: PointLight,
+    /// The panel's settings.
+    pub settings: ViewerSettings,
+    /// Render resolution.
+    pub size: (u32, u32),
+}
+
+/// A traced frame with what it cost.
+pub struct Rendered {
+    /// The image and counters.
+    pub frame: Frame,
+    /// Wall-clock seconds of the frame.
+    pub wall_s: f64,
+    /// The settings it was traced with.
+    pub settings: ViewerSettings,
+}
+
+/// What the worker reports.
+pub enum WorkerEvent {
+    /// A finished frame.
+    Frame(Box<Rendered>),
+    /// One measured configuration of a method comparison, and how many there are in all.
+    CompareRow(CompareRow, usize),
+    /// The comparison finished (or was cancelled).
+    CompareDone,
+    /// Something went wrong (for example the thread pool could not start); the message says what.
+    Error(String),
+}
+
+enum Task {
+    Frame(Job),
+    Compare(Job),
+}
+
+#[derive(Default)]
+struct State {
+    next: Option<Task>,
+    repeat: Option<Job>,
+    cancel: bool,
+    quit: bool,
+}
+
+struct Shared {
+    state: Mutex<State>,
+    wake_worker: Condvar,
+}
+
+impl Shared {
+    /// The state, even if a panicking thread poisoned the lock (the state stays consistent: plain fields).
+    fn lock(&self) -> MutexGuard<'_, State> {
+        self.state.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+/// Handle to the render worker thread.
+pub struct Worker {
+    shared: Arc<Shared>,
+    events: Receiver<WorkerEvent>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Worker {
+    /// Starts the worker; `wake` is called after every event it sends (to wake the event loop).
+    pub fn start(wake: impl Fn() + Send + 'static) -> Self {
+        let shared = Arc::new(Shared { state: Mutex::new(State::default()), wake_worker: Condvar::new() });
+        let (tx, events) = mpsc::channel();
+        let s = Arc::clone(&shared);
+        let thread = std::thread::Builder::new()
+            .name("raylab-render".into())
+            .spawn(move || run(&s, &tx, &wake))
+            .expect("the operating system refused to start the render thread");
+        Self { shared, events, thread: Some(thread) }
+    }
+
+    /// Asks for `job` to be traced next, replacing any request not yet started.
+    pub fn request(&self, job: Job) {
+        self.shared.lock().next = Some(Task::Frame(job));
+        self.shared.wake_worker.notify_one();
+    }
+
+    /// Asks for a comparison of every method and tile size on `job`'s view.
+    pub fn compare(&self, job: Job) {
+        let mut st = self.shared.lock();
+        st.cancel = false;
+        st.next = Some(Task::Compare(job));
+        drop(st);
+        self.shared.wake_worker.notify_one();
+    }
+
+    /// Stops a running comparison after its current configuration.
+    pub fn cancel_compare(&self) {
+        self.shared.lock().cancel = true;
+    }
+
+    /// Events sent since the last call.
+    pub fn drain(&self) -> Vec<WorkerEvent> {
+        self.events.try_iter().collect()
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        let mut st = self.shared.lock();
+        st.quit = true;
+        st.cancel = true;
+        drop(st);
+        self.shared.wake_worker.notify_one();
+        if let Some(t) = self.thread.take() {
+            // A worker that panicked has nothing left to clean up.
+            let _ = t.join();
+        }
+    }
+}
+
+/// The worker's loop.
+fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
+    let mut pool: Option<(usize, rayon::ThreadPool)> = None;
+    loop {
+        let task = {
+            let mut st = shared.lock();
+            loop {
+                if st.quit {
+                    return;
+                }
+                if let Some(t) = st.next.take() {
+                    break t;
+                }
+                if let Some(j) = st.repeat.clone() {
+                    break Task::Frame(j);
+                }
+                st = shared.wake_worker.wait(st).unwrap_or_else(|p| p.into_inner());
+            }
+        };
+        let job = match &task {
+            Task::Frame(j) | Task::Compare(j) => j,
+        };
+        let threads = job.settings.threads.max(1);
+        if pool.as_ref().is_none_or(|(n, _)| *n != threads) {
+            match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+                Ok(p) => pool = Some((threads, p)),
+                Err(e) => {
+                    shared.lock().repeat = None;
+                    send(tx, wake, WorkerEvent::Error(format!("cannot start {threads} tracer threads: {e}")));
+                    continue;
+                }
+            }
+        }
+        let Some((_, pool)) = pool.as_ref() else { continue };
+        match task {
+            Task::Frame(job) => {
+                let rendered = pool.install(|| trace_frame(&job, job.settings.trace.method));
+                shared.lock().repeat = job.settings.continuous.then(|| job.clone());
+                send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
+            }
+            Task::Compare(job) => {
+                let configs = compare_configs(job.settings.tile);
+                for (method, tile) in &configs {
+                    if shared.lock().cancel {
+                        break;
+                    }
+                    let row = pool.install(|| crate::compare::measure(&job, *method, *tile));
+                    send(tx, wake, WorkerEvent::CompareRow(row, configs.len()));
+                }
+                send(tx, wake, WorkerEvent::CompareDone);
+            }
+        }
+    }
+}
+
+fn send(tx: &Sender<WorkerEvent>, wake: &dyn Fn(), ev: WorkerEvent) {
+    // The receiver goes away only when the viewer closes, when nobody needs the event.
+    let _ = tx.send(ev);
+    wake();
+}
+
+/// Traces `job` with `method` on the current rayon pool.
+pub fn trace_frame(job: &Job, method: Method) -> Rendered {
+    let s = &job.scene;
+    let settings = job.settings.render_settings(job.size.0, job.size.1);
+    let tracer = Tracer::new(&s.tree, None, raylab_core::trace::TraceOptions { method, ..job.settings.trace });
+    let t0 = Instant::now();
+    let frame = render(&s.scene, &tracer, &job.camera, job.light, &settings);
+    Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings }
+}

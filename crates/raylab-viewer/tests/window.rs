@@ -1,0 +1,160 @@
+//! The viewer in a real window (under Xvfb when no display is set) and offscreen: for every interactive
+//! traversal method and shadow technique, the traced region of a window screenshot must equal the image
+//! `raylab-bench render` makes of the same view and settings, texel for pixel, and the panel must be drawn.
+//!
+//! Needs a Vulkan or GL driver (Mesa's lavapipe will do: `mesa-vulkan-drivers libvulkan1`) and, without a
+//! display, `xvfb-run` (`xvfb xauth`). A missing piece fails the test with a message naming it.
+
+use std::path::Path;
+use std::process::Command;
+
+use raylab_bench::args::SceneArgs;
+use raylab_bench::still::render_still;
+use raylab_core::kdtree::KdParams;
+use raylab_core::method::Method;
+use raylab_core::render::{FrameView, RayOrder, RenderSettings};
+use raylab_core::trace::TraceOptions;
+
+const W: u32 = 720;
+const H: u32 = 400;
+const TILE: u32 = 8;
+/// Drop shadows of egui popups and panel edges reach this far beyond their rectangles.
+const SHADOW_MARGIN: f32 = 24.0;
+
+const METHODS: [Method; 6] =
+    [Method::Mono, Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone];
+
+fn has_display() -> bool {
+    ["DISPLAY", "WAYLAND_DISPLAY"].iter().any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
+}
+
+/// The viewer, wrapped in `xvfb-run` when there is no display (or always offscreen with `headless`).
+fn viewer(headless: bool, runtime: &Path) -> Command {
+    let exe = env!("CARGO_BIN_EXE_raylab");
+    let mut c = if headless || has_display() {
+        Command::new(exe)
+    } else {
+        let mut c = Command::new("xvfb-run");
+        c.args(["-a", "-s", "-screen 0 1024x768x24", exe]);
+        c
+    };
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        c.env("XDG_RUNTIME_DIR", runtime);
+    }
+    if headless {
+        c.arg("--headless");
+    }
+    c
+}
+
+/// Runs the viewer for two traced frames and returns the window screenshot and the stats file.
+fn run_viewer(dir: &Path, name: &str, headless: bool, args: &[&str]) -> (image::RgbaImage, serde_json::Value) {
+    let shot = dir.join(format!("{name}.png"));
+    let stats = dir.join(format!("{name}.json"));
+    let out = viewer(headless, dir)
+        .args(["--scene", "atrium", "--width", &W.to_string(), "--height", &H.to_string()])
+        .args(["--tile", &TILE.to_string(), "--threads", "2", "--frames", "2"])
+        .args(args)
+        .arg("--screenshot")
+        .arg(&shot)
+        .arg("--json-stats")
+        .arg(&stats)
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("cannot start the viewer ({e}); without a display it needs xvfb-run: apt-get install xvfb xauth")
+        });
+    assert!(
+        out.status.success(),
+        "{name}: the viewer failed ({}):\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = image::open(&shot).unwrap_or_else(|e| panic!("{name}: no screenshot: {e}")).to_rgba8();
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    (img, json)
+}
+
+/// The `raylab-bench render` image of the same view.
+fn reference(method: Method, shadows: bool, show: FrameView) -> image::RgbaImage {
+    let settings = RenderSettings {
+        width: W,
+        height: H,
+        tile: TILE,
+        order: RayOrder::Scanline,
+        shadows,
+        view: show,
+        heat_max: None,
+    };
+    let options = TraceOptions { method, ..TraceOptions::default() };
+    render_still(&SceneArgs::named("atrium"), &KdParams::default(), options, &settings, 2).unwrap().image().unwrap()
+}
+
+fn rect(v: &serde_json::Value) -> [f32; 4] {
+    let a = v.as_array().expect("a rectangle");
+    [0, 1, 2, 3].map(|i| a[i].as_f64().unwrap() as f32)
+}
+
+/// Checks the screenshot against the reference outside the UI's rectangles and that the panel is drawn.
+fn check(name: &str, shot: &image::RgbaImage, stats: &serde_json::Value, want: &image::RgbaImage) {
+    assert_eq!(shot.dimensions(), (W, H), "{name}: window size");
+    assert_eq!(stats["render"], serde_json::json!([W, H]), "{name}: render resolution");
+    let covered: Vec<[f32; 4]> = stats["ui_rects"].as_array().unwrap().iter().map(rect).collect();
+    let inside = |x: u32, y: u32, r: &[f32; 4], m: f32| {
+        let (x, y) = (x as f32 + 0.5, y as f32 + 0.5);
+        x >= r[0] - m && x < r[2] + m && y >= r[1] - m && y < r[3] + m
+    };
+    let (mut compared, mut differ) = (0usize, Vec::new());
+    for (x, y, p) in shot.enumerate_pixels() {
+        if covered.iter().any(|r| inside(x, y, r, SHADOW_MARGIN)) {
+            continue;
+        }
+        compared += 1;
+        if p != want.get_pixel(x, y) {
+            differ.push((x, y, *p, *want.get_pixel(x, y)));
+        }
+    }
+    assert!(compared > (W * H / 4) as usize, "{name}: only {compared} traced pixels visible");
+    assert!(
+        differ.is_empty(),
+        "{name}: {} of {compared} traced pixels differ, first {:?}",
+        differ.len(),
+        &differ[..3.min(differ.len())]
+    );
+
+    let panel = rect(&stats["panel_rect"]);
+    assert!(panel[2] - panel[0] > 100.0, "{name}: the panel is too narrow: {panel:?}");
+    let (mut in_panel, mut changed) = (0usize, 0usize);
+    for (x, y, p) in shot.enumerate_pixels() {
+        if inside(x, y, &panel, 0.0) {
+            in_panel += 1;
+            changed += usize::from(p != want.get_pixel(x, y));
+        }
+    }
+    assert!(changed * 10 > in_panel * 9, "{name}: the panel area looks like the traced image ({changed}/{in_panel})");
+}
+
+#[test]
+fn window_shows_the_traced_frame_unchanged_for_every_method_and_shadow_technique() {
+    let dir = tempfile::tempdir().unwrap();
+    for method in METHODS {
+        for (shadows, flag) in [(false, "none"), (true, "hard")] {
+            let name = format!("{method}-{flag}");
+            let (shot, stats) = run_viewer(dir.path(), &name, false, &["--method", method.name(), "--shadows", flag]);
+            check(&name, &shot, &stats, &reference(method, shadows, FrameView::Shaded));
+        }
+    }
+}
+
+#[test]
+fn heat_maps_and_offscreen_runs_match_the_cli() {
+    let dir = tempfile::tempdir().unwrap();
+    for (method, show) in
+        [(Method::Mft, FrameView::Nodes), (Method::Mono, FrameView::Isects), (Method::Cone, FrameView::Depth)]
+    {
+        let name = format!("headless-{method}-{show}");
+        let (shot, stats) = run_viewer(dir.path(), &name, true, &["--method", method.name(), "--show", show.name()]);
+        check(&name, &shot, &stats, &reference(method, true, show));
+    }
+    let (shot, stats) = run_viewer(dir.path(), "window-normals", false, &["--method", "packet", "--show", "normals"]);
+    check("window-normals", &shot, &stats, &reference(Method::Packet, true, FrameView::Normals));
+}
