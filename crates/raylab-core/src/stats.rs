@@ -22,7 +22,8 @@ pub struct TraversalStats {
     pub leaves: u64,
     /// Ray/triangle intersection tests (packet/triangle tests for packet kernels).
     pub isect_tests: u64,
-    /// Packets traced: 2x2 (or 4x2) packets for coherent kernels, one per ray for single-ray kernels.
+    /// Packets traced: 2x2 packets holding at least one ray for coherent kernels, one per ray for single-ray
+    /// kernels.
     pub packets: u64,
     /// Packets skipped at a leaf because none of their rays overlaps its box (thesis 4.1.4).
     pub packets_culled: u64,

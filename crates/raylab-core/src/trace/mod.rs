@@ -138,7 +138,7 @@ impl<'a> Tracer<'a> {
         let mut tile = PacketTile::<V>::new(rays, width, height);
         let all: Vec<usize> = (0..tile.packets.len()).collect();
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
-        stats.packets += tile.packets.len() as u64;
+        stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         match self.options.method {
             Method::Frustum => match common_origin_frustum(&tile, &all) {
                 Some(f) => self.tree.intersect_frustum(&f, &mut tile, &all, self.options.cull, stats),
@@ -189,7 +189,7 @@ impl<'a> Tracer<'a> {
         let mut blocked = vec![V::Mask::from_bits(0); tile.packets.len()];
         let all: Vec<usize> = (0..tile.packets.len()).collect();
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
-        stats.packets += tile.packets.len() as u64;
+        stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         let limit = self.options.shadow_spread_limit;
         // Packets no bundle covers are traced as packets afterwards.
         let mut leftover: Option<Vec<usize>> = None;

@@ -17,7 +17,7 @@ enum Column {
 
 /// The comparison's rows and how they are shown.
 pub struct CompareTable {
-    rows: Vec<CompareRow>,
+    pub(super) rows: Vec<CompareRow>,
     total: usize,
     running: bool,
     open: bool,

@@ -484,3 +484,123 @@ impl Lab {
         rects
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::time::Duration;
+
+    use raylab_core::method::Method;
+    use raylab_core::render::{FrameView, RayOrder};
+    use raylab_core::trace::TraceOptions;
+
+    use super::*;
+    use crate::loader::load_now;
+    use crate::settings::{RenderMode, Shadows};
+
+    fn lab(method: Method) -> Lab {
+        let kd = KdParams::default();
+        let scene = load_now(&SceneArgs::named("arena"), &kd, &|_| {}).unwrap();
+        let settings = ViewerSettings {
+            mode: RenderMode::Whitted,
+            trace: TraceOptions { method, ..TraceOptions::default() },
+            tile: 8,
+            shadows: Shadows::Hard,
+            order: RayOrder::Scanline,
+            show: FrameView::Shaded,
+            heat_max: None,
+            scale: 100,
+            threads: 2,
+            continuous: false,
+        };
+        Lab::new(scene, kd, settings, Arc::new(|| {}))
+    }
+
+    /// Polls until `done` holds (at most a minute).
+    fn wait(lab: &mut Lab, done: impl Fn(&Lab) -> bool) {
+        let t0 = Instant::now();
+        while !done(lab) {
+            assert!(t0.elapsed() < Duration::from_secs(60), "timed out");
+            lab.poll();
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+
+    fn run_ui(lab: &mut Lab) {
+        let ctx = egui::Context::default();
+        let raw = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(900.0, 700.0))),
+            ..Default::default()
+        };
+        let mut out = ctx.run_ui(raw, |ui| lab.ui(ui));
+        assert!(!out.shapes.is_empty());
+        out.textures_delta.clear();
+    }
+
+    #[test]
+    fn traces_draws_the_panel_and_keeps_the_scene_when_an_open_fails() {
+        let mut l = lab(Method::Mft);
+        l.set_window_size(48, 32);
+        wait(&mut l, |l| l.latest().is_some());
+        let f = &l.latest().unwrap().frame;
+        assert_eq!((f.width, f.height), (48, 32));
+        assert!(f.stats.rays > 0);
+        run_ui(&mut l);
+        assert!(l.panel_rect.is_some_and(|r| r[2] > r[0]));
+        assert_eq!(l.ui_rects.first().copied(), l.panel_rect);
+
+        l.open("no/such/scene.obj");
+        wait(&mut l, |l| l.loading.is_none());
+        assert_eq!(l.scene().name, "arena", "a failed open keeps the current scene");
+        assert!(l.messages.iter().any(|m| m.error && m.text.contains("no/such/scene.obj")));
+        run_ui(&mut l);
+
+        l.open("kitchen");
+        wait(&mut l, |l| l.loading.is_none());
+        assert_eq!(l.scene().name, "kitchen");
+        wait(&mut l, |l| l.latest().is_some_and(|r| r.frame.stats.rays > 0) && !l.dirty);
+    }
+
+    #[test]
+    fn a_minimised_window_traces_nothing_and_resumes() {
+        let mut l = lab(Method::Packet);
+        l.set_window_size(0, 0);
+        for _ in 0..20 {
+            l.poll();
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        assert!(l.latest().is_none());
+        l.set_window_size(20, 10);
+        wait(&mut l, |l| l.latest().is_some());
+        let f = &l.latest().unwrap().frame;
+        assert_eq!((f.width, f.height), (20, 10));
+    }
+
+    #[test]
+    fn compare_measures_every_configuration() {
+        let mut l = lab(Method::Mono);
+        l.set_window_size(16, 16);
+        l.start_compare();
+        wait(&mut l, |l| !l.compare.running());
+        let want = crate::compare::compare_configs(8);
+        assert_eq!(l.compare.rows.len(), want.len());
+        for (row, (m, t)) in l.compare.rows.iter().zip(&want) {
+            assert_eq!((row.method, row.tile), (*m, *t));
+            assert!(row.fps > 0.0 && row.n > 0.0, "{row:?}");
+        }
+        run_ui(&mut l);
+    }
+
+    #[test]
+    fn camera_paths_play_one_key_per_frame() {
+        let mut l = lab(Method::Frustum);
+        l.set_window_size(16, 16);
+        let start = l.fly.camera;
+        let mut moved = start;
+        moved.eye += glam::Vec3::new(0.5, 0.0, 0.0);
+        moved.target += glam::Vec3::new(0.5, 0.0, 0.0);
+        l.play(CameraPath { scene: "arena".into(), keys: vec![start, moved] }, false);
+        wait(&mut l, |l| l.player.is_none());
+        assert_eq!(l.fly.camera, moved);
+        assert!(l.readouts.frames() >= 2);
+    }
+}
