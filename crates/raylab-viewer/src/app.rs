@@ -15,9 +15,13 @@ use crate::frontend::{Automation, Frontend};
 use crate::gpu::Gpu;
 use crate::lab::{Lab, Shot, timestamped};
 
-/// Shortest time between two UI frames while something is moving (caps the UI near 60 FPS so the tracer
-/// keeps the CPU).
+/// Shortest time between two UI frames (caps the UI near 60 FPS).
 const UI_FRAME: Duration = Duration::from_millis(16);
+/// Shortest time between two UI frames that egui asks for by itself (animations, spinners) when there was
+/// no input lately: the window stays live without taking CPU time from the tracer.
+const IDLE_FRAME: Duration = Duration::from_millis(100);
+/// How long after the last input egui's own repaint requests are served at full rate.
+const INPUT_LINGER: Duration = Duration::from_millis(500);
 
 /// Woken from other threads: a traced frame or a load is ready.
 #[derive(Debug, Clone, Copy)]
@@ -33,11 +37,28 @@ struct Windowed {
     egui_state: egui_winit::State,
     look: Option<(f64, f64)>,
     last_redraw: Instant,
+    last_input: Instant,
+    redraw_at: Option<Instant>,
+}
+
+impl Windowed {
+    /// Asks for a redraw in `delay` (or earlier, if one is already due earlier).
+    fn schedule(&mut self, delay: Duration) {
+        let t = Instant::now() + delay;
+        self.redraw_at = Some(self.redraw_at.map_or(t, |r| r.min(t)));
+    }
+
+    /// Asks for a redraw now, in answer to input.
+    fn input(&mut self) {
+        self.last_input = Instant::now();
+        self.schedule(Duration::ZERO);
+    }
 }
 
 /// The application.
 pub struct App {
     lab: Lab,
+    redraw_always: bool,
     size: (u32, u32),
     automation: Option<Automation>,
     win: Option<Windowed>,
@@ -50,6 +71,7 @@ pub fn run(
     make_lab: impl FnOnce(Arc<dyn Fn() + Send + Sync>) -> Lab,
     size: (u32, u32),
     automation: Option<Automation>,
+    redraw_always: bool,
 ) -> Result<(), String> {
     let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| {
         format!("cannot open a window ({e}); is a display available? Use --headless --frames N without one")
@@ -59,7 +81,7 @@ pub fn run(
         // The loop is gone only when the viewer is closing.
         let _ = proxy.send_event(Wake);
     });
-    let mut app = App { lab: make_lab(wake), size, automation, win: None, error: None };
+    let mut app = App { lab: make_lab(wake), redraw_always, size, automation, win: None, error: None };
     event_loop.run_app(&mut app).map_err(|e| format!("window event loop failed: {e}"))?;
     app.error.map_or(Ok(()), Err)
 }
@@ -127,6 +149,8 @@ impl App {
             egui_state,
             look: None,
             last_redraw: Instant::now(),
+            last_input: Instant::now(),
+            redraw_at: None,
         })
     }
 
@@ -137,7 +161,7 @@ impl App {
         let size = w.window.inner_size();
         let raw = w.egui_state.take_egui_input(&w.window);
         let ppp = egui_winit::pixels_per_point(&w.front.egui, &w.window);
-        let frame = w.front.build(&mut self.lab, raw, (size.width, size.height), ppp);
+        let mut frame = w.front.build(&mut self.lab, raw, (size.width, size.height), ppp);
         w.egui_state.handle_platform_output(&w.window, frame.platform.clone());
         if size.width == 0 || size.height == 0 {
             // Minimised: nothing to draw into.
@@ -162,7 +186,7 @@ impl App {
             let view = texture
                 .texture
                 .create_view(&wgpu::TextureViewDescriptor { format: Some(w.view_format), ..Default::default() });
-            w.front.draw(&frame, &view, (w.config.width, w.config.height));
+            w.front.draw(&mut frame, &view, (w.config.width, w.config.height));
             w.front.gpu.queue.present(texture);
         }
         let done = self.automation.as_ref().filter(|a| a.due(&self.lab, &frame));
@@ -176,8 +200,9 @@ impl App {
             }
             return;
         }
-        if frame.repaint_delay.is_zero() {
-            w.window.request_redraw();
+        if frame.repaint_delay < Duration::MAX {
+            let floor = if w.last_input.elapsed() < INPUT_LINGER { Duration::ZERO } else { IDLE_FRAME };
+            w.schedule(frame.repaint_delay.max(floor));
         }
         w.front.finish(&mut self.lab, frame);
     }
@@ -206,8 +231,8 @@ impl ApplicationHandler<Wake> for App {
             return;
         }
         match self.open_window(event_loop) {
-            Ok(w) => {
-                w.window.request_redraw();
+            Ok(mut w) => {
+                w.schedule(Duration::ZERO);
                 self.win = Some(w);
             }
             Err(e) => self.fail(event_loop, e),
@@ -215,16 +240,17 @@ impl ApplicationHandler<Wake> for App {
     }
 
     fn user_event(&mut self, _event_loop: &ActiveEventLoop, _event: Wake) {
-        if let Some(w) = &self.win {
-            w.window.request_redraw();
+        if let Some(w) = &mut self.win {
+            w.schedule(Duration::ZERO);
         }
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         let Some(w) = &mut self.win else { return };
         let response = w.egui_state.on_window_event(&w.window, &event);
-        if response.repaint {
-            w.window.request_redraw();
+        // egui marks every event as needing a repaint, the redraw itself included; only real input counts.
+        if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
+            w.input();
         }
         let egui_keys = w.front.egui.egui_wants_keyboard_input();
         let egui_pointer = w.front.egui.is_pointer_over_egui();
@@ -236,7 +262,7 @@ impl ApplicationHandler<Wake> for App {
                     w.config.height = size.height;
                     w.surface.configure(&w.front.gpu.device, &w.config);
                 }
-                w.window.request_redraw();
+                w.input();
             }
             WindowEvent::RedrawRequested => self.redraw(event_loop),
             WindowEvent::Focused(false) => {
@@ -252,8 +278,8 @@ impl ApplicationHandler<Wake> for App {
                         self.key(code, down);
                     }
                 }
-                if let Some(w) = &self.win {
-                    w.window.request_redraw();
+                if let Some(w) = &mut self.win {
+                    w.input();
                 }
             }
             WindowEvent::MouseInput { state, button: MouseButton::Right, .. } => {
@@ -265,7 +291,7 @@ impl ApplicationHandler<Wake> for App {
                         self.lab.look((position.x - x) as f32, (position.y - y) as f32);
                     }
                     w.look = Some((position.x, position.y));
-                    w.window.request_redraw();
+                    w.input();
                 }
             }
             WindowEvent::MouseWheel { delta, .. } if !egui_pointer => {
@@ -280,17 +306,25 @@ impl ApplicationHandler<Wake> for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        let Some(w) = &self.win else { return };
-        if self.lab.busy() {
-            let next = w.last_redraw + UI_FRAME;
-            if Instant::now() >= next {
-                w.window.request_redraw();
-                event_loop.set_control_flow(ControlFlow::Wait);
-            } else {
-                event_loop.set_control_flow(ControlFlow::WaitUntil(next));
+        let Some(w) = &mut self.win else { return };
+        if let Some(d) = self.lab.next_redraw() {
+            w.schedule(d);
+        }
+        if self.redraw_always {
+            w.schedule(Duration::ZERO);
+        }
+        match w.redraw_at {
+            Some(t) => {
+                let due = t.max(w.last_redraw + UI_FRAME);
+                if Instant::now() >= due {
+                    w.redraw_at = None;
+                    w.window.request_redraw();
+                    event_loop.set_control_flow(ControlFlow::Wait);
+                } else {
+                    event_loop.set_control_flow(ControlFlow::WaitUntil(due));
+                }
             }
-        } else {
-            event_loop.set_control_flow(ControlFlow::Wait);
+            None => event_loop.set_control_flow(ControlFlow::Wait),
         }
     }
 }

@@ -46,6 +46,10 @@ pub struct Cli {
     /// Window (or offscreen image) height in pixels.
     #[arg(long, default_value_t = 720, value_parser = in_range(16, 8192))]
     pub height: u64,
+    /// Redraw the UI as often as it can (up to 60 FPS) instead of only on input and new frames: measures how
+    /// responsive the UI stays while the tracer runs.
+    #[arg(long)]
+    pub redraw_always: bool,
     /// Start with the side panel hidden (Tab toggles it).
     #[arg(long)]
     pub no_panel: bool,

@@ -33,7 +33,9 @@ pub struct UiFrame {
     pub repaint_delay: Duration,
     /// CPU time of the frame upload, when a new traced frame was uploaded.
     pub upload_ms: Option<f64>,
-    started: Instant,
+    /// CPU milliseconds spent on this UI frame so far: running egui, tessellating, encoding and submitting
+    /// (not the upload, and not waiting for the window's next image).
+    cpu_ms: f64,
 }
 
 impl Frontend {
@@ -66,23 +68,24 @@ impl Frontend {
             platform: out.platform_output,
             repaint_delay,
             upload_ms,
-            started,
+            cpu_ms: started.elapsed().as_secs_f64() * 1e3 - upload_ms.unwrap_or(0.0),
         }
     }
 
     /// Draws `frame` into `target` (of `size` pixels) and submits it.
-    pub fn draw(&mut self, frame: &UiFrame, target: &wgpu::TextureView, size: (u32, u32)) {
+    pub fn draw(&mut self, frame: &mut UiFrame, target: &wgpu::TextureView, size: (u32, u32)) {
+        let t0 = Instant::now();
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ui") });
         let extra = self.compositor.prepare_egui(device, queue, &mut encoder, &frame.jobs, &frame.screen);
         self.compositor.draw(queue, &mut encoder, target, size, &frame.jobs, &frame.screen);
         queue.submit(extra.into_iter().chain([encoder.finish()]));
+        frame.cpu_ms += t0.elapsed().as_secs_f64() * 1e3;
     }
 
     /// Saves the window shots `lab` asked for, then lets egui free what it no longer needs, and records the
     /// UI frame's cost.
     pub fn finish(&mut self, lab: &mut Lab, frame: UiFrame) {
-        let ui_ms = frame.started.elapsed().as_secs_f64() * 1e3 - frame.upload_ms.unwrap_or(0.0);
         for path in lab.take_window_shots() {
             match self.screenshot(&frame, &path) {
                 Ok(()) => lab.message(format!("saved the window to {}", path.display()), false),
@@ -90,7 +93,7 @@ impl Frontend {
             }
         }
         self.compositor.free_egui(&frame.free);
-        lab.readouts.push_ui(frame.upload_ms, ui_ms);
+        lab.readouts.push_ui(frame.upload_ms, frame.cpu_ms);
     }
 
     /// Draws `frame` offscreen and writes it as PNG.

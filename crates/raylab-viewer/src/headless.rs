@@ -51,8 +51,8 @@ pub fn run(
             time: Some(epoch.elapsed().as_secs_f64()),
             ..Default::default()
         };
-        let frame = front.build(&mut lab, raw, size, 1.0);
-        front.draw(&frame, &view, size);
+        let mut frame = front.build(&mut lab, raw, size, 1.0);
+        front.draw(&mut frame, &view, size);
         if automation.due(&lab, &frame) {
             let r = automation.finish(&front, &lab, &frame);
             front.finish(&mut lab, frame);

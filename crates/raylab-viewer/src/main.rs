@@ -81,6 +81,6 @@ fn run(cli: &Cli) -> Result<(), String> {
         let a = automation.ok_or("--headless needs --frames N")?;
         headless::run(make_lab, size, a)
     } else {
-        app::run(make_lab, size, automation)
+        app::run(make_lab, size, automation, cli.redraw_always)
     }
 }

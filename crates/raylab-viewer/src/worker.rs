@@ -1,5 +1,5 @@
 //! The render worker: one thread that owns a rayon pool of the chosen size and traces the latest requested
-//! frame, so the window's event loop never waits for the tracer. Requests replace each other (only the
+//! frame at the lowest thread priority, so the window's event loop never waits for the tracer. Requests replace each other (only the
 //! newest matters); in continuous mode the last view is traced again and again to give steady FPS readings.
 
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -138,8 +138,16 @@ impl Drop for Worker {
     }
 }
 
+/// Puts the calling thread below the UI in the scheduler's eyes (lowest niceness), so that the window stays
+/// responsive while the tracer keeps every core busy. Lowering a priority needs no privilege; should the
+/// system refuse anyway, the thread simply keeps its priority.
+fn lower_priority() {
+    let _ = thread_priority::set_current_thread_priority(thread_priority::ThreadPriority::Min);
+}
+
 /// The worker's loop.
 fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
+    lower_priority();
     let mut pool: Option<(usize, rayon::ThreadPool)> = None;
     loop {
         let task = {
@@ -162,7 +170,9 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
         };
         let threads = job.settings.threads.max(1);
         if pool.as_ref().is_none_or(|(n, _)| *n != threads) {
-            match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+            let pool_result =
+                rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| lower_priority()).build();
+            match pool_result {
                 Ok(p) => pool = Some((threads, p)),
                 Err(e) => {
                     shared.lock().repeat = None;

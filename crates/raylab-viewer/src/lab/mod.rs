@@ -25,6 +25,8 @@ pub use readouts::{Readouts, StatsReport};
 
 /// How long a message stays on screen.
 const MESSAGE_TIME: Duration = Duration::from_secs(8);
+/// Redraw interval while only a progress indicator moves.
+const PROGRESS_REDRAW: Duration = Duration::from_millis(100);
 
 /// A line shown at the bottom of the window.
 struct Message {
@@ -330,15 +332,17 @@ impl Lab {
         self.latest.as_deref()
     }
 
-    /// True while something is in progress that needs the UI to keep redrawing (a load, a comparison,
-    /// continuous tracing, a held key, a playing path).
-    pub fn busy(&self) -> bool {
-        self.loading.is_some()
-            || self.compare.running()
-            || self.settings.continuous
-            || self.keys.any()
-            || self.player.is_some()
-            || !self.messages.is_empty()
+    /// How soon the UI must be drawn again without any input or traced frame: at once while a movement
+    /// key is held (the camera flies), soon while a load or a comparison shows its progress, when the oldest
+    /// message expires; `None` when nothing changes by itself. Traced frames wake the UI on their own.
+    pub fn next_redraw(&self) -> Option<Duration> {
+        if self.keys.any() {
+            return Some(Duration::ZERO);
+        }
+        if self.loading.is_some() || self.compare.running() {
+            return Some(PROGRESS_REDRAW);
+        }
+        self.messages.iter().map(|m| MESSAGE_TIME.saturating_sub(m.at.elapsed())).min()
     }
 
     fn poll_loading(&mut self) {

@@ -120,7 +120,7 @@ impl Readouts {
                 ui.monospace("tracing the first frame...");
             }
         }
-        ui.monospace(format!("UI {:3} FPS", self.ui_fps()));
+        ui.monospace(format!("UI redraws {:3}/s", self.ui_fps()));
     }
 
     /// The readouts section of the panel.
