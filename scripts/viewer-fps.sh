@@ -47,7 +47,7 @@ PY
 done
 {
   echo
-  echo "UI responsiveness while tracing (\\`--redraw-always\\`: the UI redraws as often as it can, up to 60 FPS, instead of only on input and new frames; lavapipe draws each UI frame on the same two cores):"
+  echo 'UI responsiveness while tracing (`--redraw-always`: the UI redraws as often as it can, up to 60 FPS, instead of only on input and new frames; lavapipe draws each UI frame on the same two cores):'
   echo
   echo "| view | window | method | tile | UI FPS while tracing | UI ms | traced FPS meanwhile |"
   echo "|---|---|---|---|---|---|---|"
