@@ -95,6 +95,21 @@ impl CompareTable {
         v
     }
 
+    /// The rows in the current order as a markdown table, for pasting into notes and issues.
+    pub fn markdown(&self) -> String {
+        let mut s = String::from(
+            "| method | tile | FPS | ms | Mrays/s | N | I | culled % |\n|---|---:|---:|---:|---:|---:|---:|---:|\n",
+        );
+        for r in self.sorted() {
+            let (m, t) = (r.method.name(), r.tile);
+            s.push_str(&format!(
+                "| {m} | {t}x{t} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} |\n",
+                r.fps, r.ms, r.mrays, r.n, r.i, r.culled_pct
+            ));
+        }
+        s
+    }
+
     /// The floating window with the table; returns the rectangle it covers, when shown.
     pub fn window(&mut self, ctx: &egui::Context) -> Option<egui::Rect> {
         if !self.open {
@@ -116,6 +131,9 @@ impl CompareTable {
                     "median of {} frames per row after a warm-up; N and I per 2x2 packet as in thesis Tables 4.1-4.5",
                     crate::compare::TIMED_FRAMES
                 ));
+                if !self.rows.is_empty() && ui.button("Copy as markdown").clicked() {
+                    ui.ctx().copy_text(self.markdown());
+                }
                 let best = self.rows.iter().map(|r| r.fps).fold(0.0, f64::max);
                 egui::Grid::new("compare").striped(true).num_columns(7).show(ui, |ui| {
                     for (c, name) in [

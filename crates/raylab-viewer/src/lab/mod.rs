@@ -591,6 +591,9 @@ mod tests {
             assert_eq!((row.method, row.tile), (*m, *t));
             assert!(row.fps > 0.0 && row.n > 0.0, "{row:?}");
         }
+        let md = l.compare.markdown();
+        assert_eq!(md.lines().count(), want.len() + 2);
+        assert!(md.lines().any(|line| line.starts_with("| mft | 64x64 |")), "{md}");
         run_ui(&mut l);
     }
 
