@@ -7,6 +7,8 @@
 #   REPS=3 scripts/bench-vs-embree.sh
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=lib/splice.sh
+source "$root/scripts/lib/splice.sh"
 shared=${SHARED:-$root/../shared}
 reps=${REPS:-7}
 harness=$root/target/embree-bench
@@ -22,11 +24,6 @@ target/release/raylab-bench compare --embree target/embree-bench/embree_bench \
   --light 0,11,0 --width 512 --height 512 --threads 1,2 --reps "$reps" --warmup 1 --builds 3 --markdown "$table"
 
 # Replace the text between the markers in docs/BENCHMARKS.md with the fresh table.
-awk -v table="$table" '
-  /<!-- mono-vs-embree:begin -->/ { print; while ((getline line < table) > 0) print line; skip = 1; next }
-  /<!-- mono-vs-embree:end -->/ { skip = 0 }
-  !skip { print }
-' docs/BENCHMARKS.md > docs/BENCHMARKS.md.new
-mv docs/BENCHMARKS.md.new docs/BENCHMARKS.md
+splice_section mono-vs-embree "$table"
 rm -f "$table"
 echo "updated docs/BENCHMARKS.md"

@@ -6,6 +6,8 @@
 #   REPS=3 scripts/thesis-tables.sh
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=lib/splice.sh
+source "$root/scripts/lib/splice.sh"
 reps=${REPS:-5}
 cargo build --release -p raylab-bench --manifest-path "$root/Cargo.toml"
 
@@ -14,11 +16,6 @@ table=$(mktemp)
 target/release/raylab-bench tables --scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 \
   --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0 --threads 2 --reps "$reps" --markdown "$table"
 
-awk -v table="$table" '
-  /<!-- thesis-tables:begin -->/ { print; while ((getline line < table) > 0) print line; skip = 1; next }
-  /<!-- thesis-tables:end -->/ { skip = 0 }
-  !skip { print }
-' docs/BENCHMARKS.md > docs/BENCHMARKS.md.new
-mv docs/BENCHMARKS.md.new docs/BENCHMARKS.md
+splice_section thesis-tables "$table"
 rm -f "$table"
 echo "updated docs/BENCHMARKS.md"

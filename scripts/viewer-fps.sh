@@ -8,6 +8,8 @@
 #   FRAMES=30 scripts/viewer-fps.sh
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=lib/splice.sh
+source "$root/scripts/lib/splice.sh"
 frames=${FRAMES:-60}
 cargo build --release -p raylab-viewer --manifest-path "$root/Cargo.toml"
 cd "$root"
@@ -64,11 +66,6 @@ PY
 echo >> "$table"
 echo "GPU: $(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['gpu'])" "$stats")." >> "$table"
 
-awk -v table="$table" '
-  /<!-- viewer-fps:begin -->/ { print; while ((getline line < table) > 0) print line; skip = 1; next }
-  /<!-- viewer-fps:end -->/ { skip = 0 }
-  !skip { print }
-' docs/BENCHMARKS.md > docs/BENCHMARKS.md.new
-mv docs/BENCHMARKS.md.new docs/BENCHMARKS.md
+splice_section viewer-fps "$table"
 rm -rf "$work"
 echo "updated docs/BENCHMARKS.md"

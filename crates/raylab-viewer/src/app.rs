@@ -162,7 +162,7 @@ impl App {
         let raw = w.egui_state.take_egui_input(&w.window);
         let ppp = egui_winit::pixels_per_point(&w.front.egui, &w.window);
         let mut frame = w.front.build(&mut self.lab, raw, (size.width, size.height), ppp);
-        w.egui_state.handle_platform_output(&w.window, frame.platform.clone());
+        w.egui_state.handle_platform_output(&w.window, std::mem::take(&mut frame.platform));
         if size.width == 0 || size.height == 0 {
             // Minimised: nothing to draw into.
             w.front.finish(&mut self.lab, frame);

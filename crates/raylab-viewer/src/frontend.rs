@@ -124,7 +124,7 @@ struct StatsFile<'a> {
     gpu: &'a str,
     window: [u32; 2],
     render: [u32; 2],
-    settings: crate::settings::SettingsReport,
+    settings: crate::settings::ViewerSettings,
     /// The side panel's rectangle in pixels (x0, y0, x1, y1), or null when hidden.
     panel_rect: Option<[f32; 4]>,
     /// Everything the UI drew over the traced image (the panel first), in pixels.
@@ -154,7 +154,7 @@ impl Automation {
                 gpu: &lab.gpu_name,
                 window: frame.screen.size_in_pixels,
                 render: [latest.frame.width, latest.frame.height],
-                settings: latest.settings.report(),
+                settings: latest.settings,
                 panel_rect: lab.panel_rect,
                 ui_rects: &lab.ui_rects,
                 readouts: lab.readouts.report(),

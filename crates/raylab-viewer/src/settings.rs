@@ -5,10 +5,10 @@ use clap::ValueEnum;
 use raylab_core::method::Method;
 use raylab_core::render::{FrameView, RayOrder, RenderSettings};
 use raylab_core::trace::TraceOptions;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 /// How a frame is made.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RenderMode {
     /// Primary rays and shadow rays with the benchmark shading (Whitted-style, thesis chapter 4).
@@ -17,7 +17,7 @@ pub enum RenderMode {
 }
 
 /// Shadow technique.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Shadows {
     /// No shadow rays: every surface facing the light is lit.
@@ -27,8 +27,8 @@ pub enum Shadows {
     Hard,
 }
 
-/// The frame settings the UI controls.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The frame settings the UI controls (and the `--json-stats` file records).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ViewerSettings {
     /// Render mode.
     pub mode: RenderMode,
@@ -75,24 +75,6 @@ impl ViewerSettings {
         }
     }
 
-    /// The settings as the stats file records them.
-    pub fn report(&self) -> SettingsReport {
-        SettingsReport {
-            mode: self.mode,
-            method: self.trace.method,
-            tile: self.tile,
-            cull: self.trace.cull,
-            backend: self.trace.backend.name(),
-            shadow_spread_limit: self.trace.shadow_spread_limit,
-            shadows: self.shadows,
-            order: self.order,
-            show: self.show,
-            heat_max: self.heat_max,
-            scale: self.scale,
-            threads: self.threads,
-        }
-    }
-
     /// Why `method` cannot be chosen in the current mode, if it cannot.
     pub fn method_unavailable(&self, method: Method) -> Option<&'static str> {
         match method {
@@ -100,33 +82,4 @@ impl ViewerSettings {
             _ => None,
         }
     }
-}
-
-/// [`ViewerSettings`] as written to the `--json-stats` file.
-#[derive(Clone, Debug, Serialize)]
-pub struct SettingsReport {
-    /// Render mode.
-    pub mode: RenderMode,
-    /// Traversal method.
-    pub method: Method,
-    /// Tile edge.
-    pub tile: u32,
-    /// Packet/leaf culling.
-    pub cull: bool,
-    /// SIMD backend name.
-    pub backend: &'static str,
-    /// Shadow spread limit of the frustum methods.
-    pub shadow_spread_limit: f32,
-    /// Shadow technique.
-    pub shadows: Shadows,
-    /// Ray order.
-    pub order: RayOrder,
-    /// Frame view.
-    pub show: FrameView,
-    /// Fixed heat-map maximum.
-    pub heat_max: Option<f32>,
-    /// Render scale in percent.
-    pub scale: u32,
-    /// Tracer threads.
-    pub threads: usize,
 }

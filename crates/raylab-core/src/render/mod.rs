@@ -9,7 +9,7 @@ mod view;
 
 pub use order::RayOrder;
 pub use stages::StageTimes;
-pub use view::{FrameView, heat_color};
+pub use view::{FrameView, depth_grey, heat_color};
 
 use std::time::Instant;
 
@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::method::Method;
-use crate::ray::Ray;
+use crate::ray::{Hit, Ray};
 use crate::scene::{Camera, CameraRaster, PointLight, Scene};
 use crate::stats::TraversalStats;
 use crate::trace::Tracer;
@@ -92,6 +92,8 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     let tile = settings.tile.max(1);
     let bounds = scene.bounds();
+    // Single rays are traced in the chosen order; packet methods need the tile's pixels row by row.
+    let order = if tracer.options.method.uses_packets() { RayOrder::Scanline } else { settings.order };
     let ctx = TileContext {
         scene,
         tracer,
@@ -100,8 +102,8 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
         settings,
         width: w,
         epsilon: if bounds.is_empty() { 0.0 } else { 1e-4 * bounds.diagonal() },
-        // Single rays are traced in the chosen order; packet methods need the tile's pixels row by row.
-        order: if tracer.options.method.uses_packets() { RayOrder::Scanline } else { settings.order },
+        order,
+        offsets: order.offsets(tile, tile),
     };
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
@@ -139,14 +141,13 @@ fn value_range(tiles: &[TileOut], settings: &RenderSettings) -> (f32, f32) {
     }
 }
 
-/// Grey level of a hit distance: white at the nearest hit, dark at the farthest, black for misses.
+/// Grey level of a hit distance: [`depth_grey`] of its place between the nearest and the farthest hit; black
+/// for misses.
 fn depth_color(t: f32, near: f32, far: f32) -> [u8; 4] {
     if !t.is_finite() {
         return [0, 0, 0, 255];
     }
-    let x = if far > near { (t - near) / (far - near) } else { 0.0 };
-    let g = to_display(1.0 - 0.9 * x);
-    [g, g, g, 255]
+    depth_grey(if far > near { (t - near) / (far - near) } else { 0.0 })
 }
 
 /// Edge of the blocks a method traces as one unit: a ray, a 2x2 packet, or the whole tile for frustums.
@@ -170,6 +171,18 @@ struct TileContext<'a> {
     width: u32,
     epsilon: f32,
     order: RayOrder,
+    /// The pixel offsets of a whole tile in `order`, computed once per frame.
+    offsets: Vec<(u32, u32)>,
+}
+
+/// Buffers of one block of rays, reused from block to block of a tile.
+#[derive(Default)]
+struct Scratch {
+    pixels: Vec<(u32, u32)>,
+    rays: Vec<Option<Ray>>,
+    hits: Vec<Option<Hit>>,
+    shadow: Vec<Option<Ray>>,
+    blocked: Vec<bool>,
 }
 
 impl TileContext<'_> {
@@ -177,9 +190,12 @@ impl TileContext<'_> {
     /// can be shared among its own pixels; the units are exactly the pieces the method traces anyway.
     fn tile(&self, x0: u32, y0: u32, tw: u32, th: u32) -> TileOut {
         let mut out = TileOut::default();
+        let mut scratch = Scratch::default();
         let view = self.settings.view;
         if !view.is_heat_map() {
-            self.block(x0, y0, tw, th, self.order, &mut out);
+            // A partial tile at the image's edge keeps the whole tile's order.
+            let offsets = self.offsets.iter().copied().filter(|&(dx, dy)| dx < tw && dy < th);
+            self.block((x0, y0), (tw, th), offsets, self.order == RayOrder::Scanline, &mut out, &mut scratch);
             return out;
         }
         let unit = unit_size(self.tracer.options.method, self.settings.tile.max(1));
@@ -187,7 +203,9 @@ impl TileContext<'_> {
             for ux in (0..tw).step_by(unit as usize) {
                 let start = out.pixels.len();
                 let before = out.stats;
-                self.block(x0 + ux, y0 + uy, unit.min(tw - ux), unit.min(th - uy), RayOrder::Scanline, &mut out);
+                let (bw, bh) = (unit.min(tw - ux), unit.min(th - uy));
+                let rows = (0..bh).flat_map(|dy| (0..bw).map(move |dx| (dx, dy)));
+                self.block((x0 + ux, y0 + uy), (bw, bh), rows, true, &mut out, &mut scratch);
                 let work = if view == FrameView::Nodes {
                     out.stats.nodes - before.nodes
                 } else {
@@ -202,43 +220,54 @@ impl TileContext<'_> {
         out
     }
 
-    /// Traces and shades the `bw x bh` block at `(x0, y0)` in `order`, appending its pixels to `out`.
-    fn block(&self, x0: u32, y0: u32, bw: u32, bh: u32, order: RayOrder, out: &mut TileOut) {
+    /// Traces and shades the block of `(width, height)` pixels at `(x0, y0)`, its pixels visited at `offsets`
+    /// (row by row when `rows`, else as one line in the given order), appending them to `out`.
+    fn block(
+        &self,
+        (x0, y0): (u32, u32),
+        (bw, bh): (u32, u32),
+        offsets: impl Iterator<Item = (u32, u32)>,
+        rows: bool,
+        out: &mut TileOut,
+        sc: &mut Scratch,
+    ) {
         let (scene, light, settings) = (self.scene, &self.light, self.settings);
         let t0 = Instant::now();
-        let pixels: Vec<(u32, u32)> = order.offsets(bw, bh).into_iter().map(|(dx, dy)| (x0 + dx, y0 + dy)).collect();
-        let rays: Vec<Option<Ray>> = pixels.iter().map(|&(x, y)| Some(self.raster.primary(x, y))).collect();
-        let (rw, rh) = if order == RayOrder::Scanline { (bw as usize, bh as usize) } else { (rays.len(), 1) };
-        let mut hits = vec![None; rays.len()];
-        self.tracer.intersect_tile(&rays, rw, rh, &mut hits, &mut out.stats);
+        sc.pixels.clear();
+        sc.pixels.extend(offsets.map(|(dx, dy)| (x0 + dx, y0 + dy)));
+        sc.rays.clear();
+        sc.rays.extend(sc.pixels.iter().map(|&(x, y)| Some(self.raster.primary(x, y))));
+        let n = sc.rays.len();
+        let (rw, rh) = if rows { (bw as usize, bh as usize) } else { (n, 1) };
+        sc.hits.clear();
+        sc.hits.resize(n, None);
+        self.tracer.intersect_tile(&sc.rays, rw, rh, &mut sc.hits, &mut out.stats);
         let t1 = Instant::now();
 
         // Only the shaded picture and the heat maps (which count the shadow work) need shadow rays.
         let shadows =
             settings.shadows && matches!(settings.view, FrameView::Shaded | FrameView::Nodes | FrameView::Isects);
-        let shadow: Vec<Option<Ray>> = rays
-            .iter()
-            .zip(&hits)
-            .map(|(r, h)| match (r, h) {
-                (Some(r), Some(h)) if shadows => shade::shadow_ray(scene, r, h, light, self.epsilon),
-                _ => None,
-            })
-            .collect();
-        let mut blocked = vec![false; rays.len()];
-        if shadow.iter().any(Option::is_some) {
-            self.tracer.occluded_tile(&shadow, rw, rh, Some(light.position), &mut blocked, &mut out.stats);
+        sc.shadow.clear();
+        sc.shadow.extend(sc.rays.iter().zip(&sc.hits).map(|(r, h)| match (r, h) {
+            (Some(r), Some(h)) if shadows => shade::shadow_ray(scene, r, h, light, self.epsilon),
+            _ => None,
+        }));
+        sc.blocked.clear();
+        sc.blocked.resize(n, false);
+        if sc.shadow.iter().any(Option::is_some) {
+            self.tracer.occluded_tile(&sc.shadow, rw, rh, Some(light.position), &mut sc.blocked, &mut out.stats);
         }
         let t2 = Instant::now();
 
-        out.pixels.extend(pixels.iter().enumerate().map(|(i, &(x, y))| {
+        out.pixels.extend(sc.pixels.iter().enumerate().map(|(i, &(x, y))| {
             let index = y * self.width + x;
-            let (Some(r), Some(hit)) = (&rays[i], &hits[i]) else {
+            let (Some(r), Some(hit)) = (&sc.rays[i], &sc.hits[i]) else {
                 return (index, [0, 0, 0, 255], f32::INFINITY);
             };
             let c = match settings.view {
                 FrameView::Normals => shade::facing_normal(scene, r, hit) * 0.5 + Vec3::splat(0.5),
                 _ => {
-                    let visible = !shadows || (shadow[i].is_some() && !blocked[i]);
+                    let visible = !shadows || (sc.shadow[i].is_some() && !sc.blocked[i]);
                     shade::shade(scene, r, hit, light, visible)
                 }
             };

@@ -89,6 +89,13 @@ pub fn heat_color(x: f32) -> [u8; 4] {
     [c(0), c(1), c(2), 255]
 }
 
+/// The depth view's grey for `x` in `[0, 1]` (0 the nearest hit, 1 the farthest): white fading to a dark grey,
+/// so the farthest surfaces stay distinct from misses (black).
+pub fn depth_grey(x: f32) -> [u8; 4] {
+    let g = super::shade::to_display(1.0 - 0.9 * x.clamp(0.0, 1.0));
+    [g, g, g, 255]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

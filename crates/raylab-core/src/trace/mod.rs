@@ -7,6 +7,7 @@
 
 use glam::Vec3;
 use raylab_simd::{Backend, VMask, Vf32};
+use serde::Serialize;
 
 use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
@@ -17,19 +18,24 @@ use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
 use crate::stats::TraversalStats;
 
-/// How rays are traced.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// How rays are traced. Serialises into run reports (the backend by its name).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct TraceOptions {
     /// Traversal method.
     pub method: Method,
     /// Packet/leaf culling in the frustum methods (thesis 4.1.4).
     pub cull: bool,
     /// SIMD backend of the packet kernels.
+    #[serde(serialize_with = "backend_name")]
     pub backend: Backend,
     /// Widest shadow bundle (tangent of the largest angle between a ray and the bundle's mean direction, seen
     /// from the light) that the frustum methods trace as a frustum; wider tiles or quadrants, whose hit points
     /// are spread in depth, are traced as 2x2 packets instead, which is faster for them.
     pub shadow_spread_limit: f32,
+}
+
+fn backend_name<S: serde::Serializer>(b: &Backend, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(b.name())
 }
 
 impl TraceOptions {

@@ -5,7 +5,7 @@ use std::collections::VecDeque;
 use std::time::Instant;
 
 use egui_plot::{Legend, Line, Plot, PlotPoints};
-use raylab_core::render::{FrameView, StageTimes, heat_color};
+use raylab_core::render::{FrameView, StageTimes, depth_grey, heat_color};
 use raylab_core::stats::TraversalStats;
 use serde::Serialize;
 
@@ -238,12 +238,7 @@ pub fn legend(ui: &mut egui::Ui, view: FrameView, (lo, hi): (f32, f32)) {
     let steps = 36;
     for k in 0..steps {
         let x = k as f32 / (steps - 1) as f32;
-        let c = if view == FrameView::Depth {
-            let g = (255.0 * (1.0 - 0.9 * x).powf(1.0 / 2.2)) as u8;
-            [g, g, g, 255]
-        } else {
-            heat_color(x)
-        };
+        let c = if view == FrameView::Depth { depth_grey(x) } else { heat_color(x) };
         let w = rect.width() / steps as f32;
         let r = egui::Rect::from_min_size(rect.min + egui::vec2(k as f32 * w, 0.0), egui::vec2(w + 0.5, rect.height()));
         ui.painter().rect_filled(r, 0.0, egui::Color32::from_rgb(c[0], c[1], c[2]));
