@@ -3,7 +3,9 @@
 use clap::Args;
 use glam::Vec3;
 use raylab_core::kdtree::KdParams;
+use raylab_core::render::RenderSettings;
 use raylab_core::scene::{Camera, PointLight, Scene};
+use raylab_core::shadow::{SampleBound, ShadowKind, Shadows};
 use raylab_scene::SceneSource;
 
 /// Parses `X,Y,Z`.
@@ -40,6 +42,12 @@ pub fn in_range(lo: u64, hi: u64) -> impl Fn(&str) -> Result<u64, String> + Clon
     }
 }
 
+/// Parses a finite number of at least zero.
+pub fn parse_non_negative(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(format!("{v} must be finite and >= 0")) }
+}
+
 /// Parses a finite number greater than zero.
 pub fn parse_positive(s: &str) -> Result<f32, String> {
     let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
@@ -70,12 +78,24 @@ pub struct SceneArgs {
     /// Point light position X,Y,Z (defaults to the scene's light).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub light: Option<Vec3>,
+    /// Radius of the spherical light for soft shadows, in world units (defaults to the scene's light).
+    #[arg(long, value_parser = parse_non_negative)]
+    pub light_radius: Option<f32>,
 }
 
 impl SceneArgs {
     /// The scene `name` with its own default view and light.
     pub fn named(name: &str) -> Self {
-        Self { scene: name.to_string(), view: None, eye: None, target: None, up: None, fov: None, light: None }
+        Self {
+            scene: name.to_string(),
+            view: None,
+            eye: None,
+            target: None,
+            up: None,
+            fov: None,
+            light: None,
+            light_radius: None,
+        }
     }
 
     /// Where the scene comes from.
@@ -101,6 +121,9 @@ impl SceneArgs {
         let mut light = scene.lights.first().copied().unwrap_or_else(|| PointLight::at(default_light(scene)));
         if let Some(p) = self.light {
             light = PointLight { position: p, ..light };
+        }
+        if let Some(r) = self.light_radius {
+            light.radius = r;
         }
         Ok((cam, light))
     }
@@ -189,14 +212,38 @@ pub struct MethodArgs {
     pub backend: Option<raylab_simd::Backend>,
     /// Widest shadow bundle seen from the light (tangent of its half-angle) that frustum methods trace as a
     /// frustum; wider ones go as 2x2 packets. 0 traces all shadow rays as packets.
-    #[arg(long, default_value_t = raylab_core::trace::TraceOptions::SHADOW_SPREAD_LIMIT, value_parser = parse_spread)]
+    #[arg(long, default_value_t = raylab_core::trace::TraceOptions::SHADOW_SPREAD_LIMIT, value_parser = parse_non_negative)]
     pub shadow_spread_limit: f32,
 }
 
-/// Parses a non-negative finite spread limit.
-fn parse_spread(s: &str) -> Result<f32, String> {
-    let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
-    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(format!("{v} must be finite and >= 0")) }
+/// Shadow-technique and recursion flags shared by `render`, `compare` and the viewer (thesis chapter 5,
+/// section 4.1.9 and 4.2.1).
+#[derive(Args, Clone, Debug)]
+pub struct ShadeArgs {
+    /// Shadow technique: none, hard, cached (hard with the shadow cache), edge (edge-width soft shadows), or
+    /// ms4, ms8, ms16, ms32 (that many stratified samples on the spherical light).
+    #[arg(long, default_value = "hard")]
+    pub shadows: ShadowKind,
+    /// How multi-sampled shadows bound each point's samples: packets, pyramid or cone.
+    #[arg(long, default_value = "cone")]
+    pub ms_bound: SampleBound,
+    /// Edge width at which a point counts as fully shadowed, in world units (default: the light's radius).
+    #[arg(long, value_parser = parse_non_negative)]
+    pub edge_radius: Option<f32>,
+    /// Pair edge-width crossings only on triangles that share a vertex (the light-leak fix).
+    #[arg(long)]
+    pub leak_fix: bool,
+    /// Reflection and refraction depth after the primary hit (0: primary rays only).
+    #[arg(long, default_value_t = RenderSettings::DEFAULT_DEPTH as u64,
+          value_parser = in_range(0, RenderSettings::MAX_DEPTH as u64))]
+    pub depth: u64,
+}
+
+impl ShadeArgs {
+    /// The shadow technique for a scene lit by `light` (whose radius is the default edge radius).
+    pub fn shadows(&self, light: &PointLight) -> Shadows {
+        self.shadows.with(self.edge_radius.unwrap_or(light.radius), self.leak_fix, self.ms_bound)
+    }
 }
 
 impl MethodArgs {

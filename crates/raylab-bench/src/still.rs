@@ -8,7 +8,7 @@ use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
 use raylab_core::render::{Frame, RenderSettings, render};
-use raylab_core::scene::Scene;
+use raylab_core::scene::{PointLight, Scene};
 use raylab_core::trace::{TraceOptions, Tracer};
 
 use crate::args::SceneArgs;
@@ -28,16 +28,19 @@ pub struct Still {
     pub render_s: f64,
 }
 
-/// Renders `scene`'s view with `options` and `settings` on `threads` threads.
+/// Renders `scene`'s view with `options` on `threads` threads; `settings` makes the frame settings for the
+/// scene's light (the default edge-width radius is the light's radius).
 pub fn render_still(
     scene: &SceneArgs,
     kd: &KdParams,
     options: TraceOptions,
-    settings: &RenderSettings,
+    settings: impl FnOnce(&PointLight) -> RenderSettings,
     threads: usize,
 ) -> Result<Still, String> {
     let (loaded, load_s) = load_scene(&scene.source())?;
     let (camera, light) = scene.camera_and_light(&loaded)?;
+    let settings = &settings(&light);
+    settings.shadows.validate().map_err(|e| format!("--shadows: {e}"))?;
     let tree = build_tree(&loaded, kd, threads)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     let t0 = Instant::now();

@@ -16,6 +16,7 @@ pub mod ray;
 pub mod reference;
 pub mod render;
 pub mod scene;
+pub mod shadow;
 pub mod stats;
 pub mod trace;
 pub mod triangle;

@@ -5,6 +5,7 @@
 
 use crate::ray::{Hit, Ray};
 use crate::scene::Scene;
+use crate::shadow::{Crossing, EdgeWidth};
 use crate::stats::TraversalStats;
 use crate::triangle::{RayShear, TriangleSoup};
 
@@ -43,14 +44,44 @@ impl BruteForce {
 
     /// True when any triangle blocks the ray in `(tmin, tmax]`.
     pub fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        self.occluder(ray, stats).is_some()
+    }
+
+    /// The lowest-numbered triangle that blocks the ray in `(tmin, tmax]`.
+    pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         stats.rays += 1;
         stats.packets += 1;
         if !ray.is_valid() {
-            return false;
+            return None;
         }
         let shear = RayShear::new(ray);
         stats.isect_tests += self.tris.len() as u64;
-        self.tris.as_slice().iter().any(|t| shear.intersect(t, ray.tmin, ray.tmax).is_some())
+        self.tris.as_slice().iter().position(|t| shear.intersect(t, ray.tmin, ray.tmax).is_some()).map(|i| i as u32)
+    }
+
+    /// True when triangle `tri` blocks the ray in `(tmin, tmax]`.
+    pub fn blocks(&self, ray: &Ray, tri: u32) -> bool {
+        ray.is_valid() && self.hit_distance(ray, tri).is_some()
+    }
+
+    /// The edge-width occlusion of a shadow ray (thesis Listing 5.1) from all its crossings at once: the
+    /// answer the kd-tree kernel must reproduce.
+    pub fn edge_width(&self, ray: &Ray, state: &mut EdgeWidth, stats: &mut TraversalStats) -> f32 {
+        stats.rays += 1;
+        stats.packets += 1;
+        state.begin();
+        if ray.is_valid() {
+            let shear = RayShear::new(ray);
+            stats.isect_tests += self.tris.len() as u64;
+            for (i, c) in self.tris.as_slice().iter().enumerate() {
+                if let Some(h) = shear.intersect(c, ray.tmin, ray.tmax) {
+                    let n = (c[1] - c[0]).cross(c[2] - c[0]);
+                    state.add(Crossing { t: h.t, tri: i as u32, front: n.dot(ray.dir) < 0.0 });
+                }
+            }
+        }
+        state.commit(f32::INFINITY, &self.tris);
+        state.occlusion()
     }
 
     /// The distance at which `ray` hits triangle `tri`, if it does (used to check that two methods that

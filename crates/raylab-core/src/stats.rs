@@ -29,6 +29,12 @@ pub struct TraversalStats {
     pub packets_culled: u64,
     /// Packet visits to non-empty leaves that went on to triangle tests (culled ones excluded).
     pub packets_tested: u64,
+    /// Shadow rays that first tested a cached blocker (the shadow cache).
+    #[serde(default)]
+    pub cache_lookups: u64,
+    /// Cache lookups whose cached triangle blocked the ray, so no traversal was needed.
+    #[serde(default)]
+    pub cache_hits: u64,
 }
 
 impl AddAssign for TraversalStats {
@@ -40,6 +46,8 @@ impl AddAssign for TraversalStats {
         self.packets += o.packets;
         self.packets_culled += o.packets_culled;
         self.packets_tested += o.packets_tested;
+        self.cache_lookups += o.cache_lookups;
+        self.cache_hits += o.cache_hits;
     }
 }
 
@@ -57,6 +65,11 @@ impl TraversalStats {
     /// Average triangle tests per ray.
     pub fn isects_per_ray(&self) -> f64 {
         ratio(self.isect_tests, self.rays)
+    }
+
+    /// Share of shadow-cache lookups that hit (0 when there were none).
+    pub fn cache_hit_rate(&self) -> f64 {
+        ratio(self.cache_hits, self.cache_lookups)
     }
 
     /// The thesis's N: nodes visited per packet.
@@ -88,6 +101,8 @@ mod tests {
             packets: 2,
             packets_culled: 0,
             packets_tested: 0,
+            cache_lookups: 1,
+            cache_hits: 1,
         };
         a += TraversalStats {
             rays: 2,
@@ -97,8 +112,11 @@ mod tests {
             packets: 2,
             packets_culled: 1,
             packets_tested: 3,
+            cache_lookups: 3,
+            cache_hits: 0,
         };
         assert_eq!(a.nodes_per_ray(), 3.0);
+        assert_eq!(a.cache_hit_rate(), 0.25);
         assert_eq!(a.isects_per_ray(), 2.0);
         assert_eq!(TraversalStats::default().nodes_per_ray(), 0.0);
     }

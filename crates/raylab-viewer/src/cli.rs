@@ -4,10 +4,10 @@
 use std::path::PathBuf;
 
 use clap::{Parser, ValueEnum};
-use raylab_bench::args::{KdArgs, MethodArgs, SceneArgs, in_range, parse_positive};
+use raylab_bench::args::{KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_positive};
 use raylab_core::render::{FrameView, RayOrder};
 
-use crate::settings::{RenderMode, Shadows};
+use crate::settings::RenderMode;
 
 /// raylab: fly through a scene traced on the CPU, switch traversal methods live and read what they cost.
 #[derive(Parser, Debug)]
@@ -19,9 +19,8 @@ pub struct Cli {
     pub kd: KdArgs,
     #[command(flatten)]
     pub method: MethodArgs,
-    /// Shadow technique.
-    #[arg(long, value_enum, default_value_t = Shadows::Hard)]
-    pub shadows: Shadows,
+    #[command(flatten)]
+    pub shade: ShadeArgs,
     /// Render mode.
     #[arg(long, value_enum, default_value_t = RenderMode::Whitted)]
     pub mode: RenderMode,

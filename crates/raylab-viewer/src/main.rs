@@ -43,11 +43,14 @@ fn main() -> ExitCode {
 
 fn run(cli: &Cli) -> Result<(), String> {
     cli.validate()?;
+    let kd = cli.kd.params()?;
+    let scene = with_spinner("loading scene and building the kd-tree", || loader::load_now(&cli.scene, &kd, &|_| {}))?;
     let settings = ViewerSettings {
         mode: cli.mode,
         trace: cli.method.options(),
         tile: cli.method.tile as u32,
-        shadows: cli.shadows,
+        shadows: cli.shade.shadows(&scene.light),
+        depth: cli.shade.depth as u32,
         order: cli.order,
         show: cli.show,
         heat_max: cli.heat_max,
@@ -58,9 +61,8 @@ fn run(cli: &Cli) -> Result<(), String> {
     if let Some(why) = settings.method_unavailable(settings.trace.method) {
         return Err(format!("--method {}: {why}", settings.trace.method));
     }
-    let kd = cli.kd.params()?;
+    settings.shadows.validate().map_err(|e| format!("--shadows: {e}"))?;
     let path = cli.play.as_deref().map(CameraPath::load).transpose()?;
-    let scene = with_spinner("loading scene and building the kd-tree", || loader::load_now(&cli.scene, &kd, &|_| {}))?;
     let no_panel = cli.no_panel;
     let make_lab = move |wake: Arc<dyn Fn() + Send + Sync>| {
         let mut lab = Lab::new(scene, kd, settings, wake);

@@ -4,6 +4,7 @@
 use clap::ValueEnum;
 use raylab_core::method::Method;
 use raylab_core::render::{FrameView, RayOrder, RenderSettings};
+use raylab_core::shadow::Shadows;
 use raylab_core::trace::TraceOptions;
 use serde::Serialize;
 
@@ -11,20 +12,10 @@ use serde::Serialize;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RenderMode {
-    /// Primary rays and shadow rays with the benchmark shading (Whitted-style, thesis chapter 4).
+    /// Primary rays, shadow rays under the chosen technique, and reflection and refraction rays up to the
+    /// chosen depth (Whitted-style, thesis 3.3 and 4.2.1).
     #[default]
     Whitted,
-}
-
-/// Shadow technique.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Shadows {
-    /// No shadow rays: every surface facing the light is lit.
-    None,
-    /// One any-hit ray per pixel toward the point light, traced with the current method's coherent path.
-    #[default]
-    Hard,
 }
 
 /// The frame settings the UI controls (and the `--json-stats` file records).
@@ -36,8 +27,10 @@ pub struct ViewerSettings {
     pub trace: TraceOptions,
     /// Tile edge in pixels.
     pub tile: u32,
-    /// Shadow technique.
+    /// Shadow technique and its parameters.
     pub shadows: Shadows,
+    /// Reflection and refraction depth after the primary hit.
+    pub depth: u32,
     /// Pixel order of single-ray methods.
     pub order: RayOrder,
     /// What the traced image shows.
@@ -69,7 +62,8 @@ impl ViewerSettings {
             height,
             tile: self.tile,
             order: self.order,
-            shadows: self.shadows == Shadows::Hard,
+            shadows: self.shadows,
+            max_depth: self.depth,
             view: self.show,
             heat_max: self.heat_max,
         }

@@ -13,6 +13,8 @@ use raylab_bench::still::render_still;
 use raylab_core::kdtree::KdParams;
 use raylab_core::method::Method;
 use raylab_core::render::{FrameView, RayOrder, RenderSettings};
+use raylab_core::scene::PointLight;
+use raylab_core::shadow::{SampleBound, ShadowKind};
 use raylab_core::trace::TraceOptions;
 
 const W: u32 = 720;
@@ -75,18 +77,19 @@ fn run_viewer(dir: &Path, name: &str, headless: bool, args: &[&str]) -> (image::
 }
 
 /// The `raylab-bench render` image of the same view.
-fn reference(method: Method, shadows: bool, show: FrameView) -> image::RgbaImage {
-    let settings = RenderSettings {
+fn reference(method: Method, shadows: ShadowKind, show: FrameView) -> image::RgbaImage {
+    let settings = |light: &PointLight| RenderSettings {
         width: W,
         height: H,
         tile: TILE,
         order: RayOrder::Scanline,
-        shadows,
+        shadows: shadows.with(light.radius, false, SampleBound::Cone),
+        max_depth: RenderSettings::DEFAULT_DEPTH,
         view: show,
         heat_max: None,
     };
     let options = TraceOptions { method, ..TraceOptions::default() };
-    render_still(&SceneArgs::named("atrium"), &KdParams::default(), options, &settings, 2).unwrap().image().unwrap()
+    render_still(&SceneArgs::named("atrium"), &KdParams::default(), options, settings, 2).unwrap().image().unwrap()
 }
 
 fn rect(v: &serde_json::Value) -> [f32; 4] {
@@ -137,11 +140,18 @@ fn check(name: &str, shot: &image::RgbaImage, stats: &serde_json::Value, want: &
 fn window_shows_the_traced_frame_unchanged_for_every_method_and_shadow_technique() {
     let dir = tempfile::tempdir().unwrap();
     for method in METHODS {
-        for (shadows, flag) in [(false, "none"), (true, "hard")] {
+        for flag in ["none", "hard"] {
             let name = format!("{method}-{flag}");
             let (shot, stats) = run_viewer(dir.path(), &name, false, &["--method", method.name(), "--shadows", flag]);
-            check(&name, &shot, &stats, &reference(method, shadows, FrameView::Shaded));
+            check(&name, &shot, &stats, &reference(method, flag.parse().unwrap(), FrameView::Shaded));
         }
+    }
+    // The soft techniques, each with one method (the method changes no pixels; tests/shadows.rs in
+    // raylab-scene proves that for every pair).
+    for (method, flag) in [(Method::Packet, "cached"), (Method::Mft, "edge"), (Method::Mono, "ms4")] {
+        let name = format!("{method}-{flag}");
+        let (shot, stats) = run_viewer(dir.path(), &name, false, &["--method", method.name(), "--shadows", flag]);
+        check(&name, &shot, &stats, &reference(method, flag.parse().unwrap(), FrameView::Shaded));
     }
 }
 
@@ -153,8 +163,8 @@ fn heat_maps_and_offscreen_runs_match_the_cli() {
     {
         let name = format!("headless-{method}-{show}");
         let (shot, stats) = run_viewer(dir.path(), &name, true, &["--method", method.name(), "--show", show.name()]);
-        check(&name, &shot, &stats, &reference(method, true, show));
+        check(&name, &shot, &stats, &reference(method, ShadowKind::Hard, show));
     }
     let (shot, stats) = run_viewer(dir.path(), "window-normals", false, &["--method", "packet", "--show", "normals"]);
-    check("window-normals", &shot, &stats, &reference(Method::Packet, true, FrameView::Normals));
+    check("window-normals", &shot, &stats, &reference(Method::Packet, ShadowKind::Hard, FrameView::Normals));
 }

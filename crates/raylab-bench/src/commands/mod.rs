@@ -3,5 +3,6 @@
 pub mod compare;
 pub mod info;
 pub mod render;
+pub mod shading_tables;
 pub mod tables;
 pub mod trace;

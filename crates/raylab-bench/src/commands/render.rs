@@ -1,4 +1,5 @@
-//! `raylab-bench render`: one frame with the benchmark shading, written as PNG.
+//! `raylab-bench render`: one frame, shaded with the scene's materials under a chosen shadow technique,
+//! written as PNG.
 
 use std::path::PathBuf;
 
@@ -6,7 +7,7 @@ use clap::Args;
 use raylab_bench::still::{Still, render_still};
 use raylab_core::render::{FrameView, RayOrder, RenderSettings};
 
-use crate::args::{KdArgs, MethodArgs, SceneArgs, in_range, parse_positive};
+use crate::args::{KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_positive};
 
 /// Renders one frame to a PNG file.
 #[derive(Args, Debug)]
@@ -29,9 +30,8 @@ pub struct RenderArgs {
     /// Pixel order inside a tile: scanline, morton or hilbert.
     #[arg(long, default_value = "scanline")]
     order: RayOrder,
-    /// Skip the hard-shadow rays.
-    #[arg(long)]
-    no_shadows: bool,
+    #[command(flatten)]
+    shade: ShadeArgs,
     /// What the image shows: shaded, nodes or isects (heat maps of the work per pixel), normals or depth.
     #[arg(long, default_value = "shaded")]
     show: FrameView,
@@ -59,17 +59,18 @@ impl RenderArgs {
 /// Runs the command.
 pub fn run(a: &RenderArgs) -> Result<(), String> {
     let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
-    let settings = RenderSettings {
+    let settings = |light: &_| RenderSettings {
         width: a.width as u32,
         height: a.height as u32,
         tile: a.m.tile as u32,
         order: a.order,
-        shadows: !a.no_shadows,
+        shadows: a.shade.shadows(light),
+        max_depth: a.shade.depth as u32,
         view: a.show,
         heat_max: a.heat_max,
     };
     let Still { scene, tree, frame, load_s, render_s } =
-        render_still(&a.scene, &a.kd.params()?, a.m.options(), &settings, threads)?;
+        render_still(&a.scene, &a.kd.params()?, a.m.options(), settings, threads)?;
     let img = image::RgbaImage::from_raw(frame.width, frame.height, frame.rgba.as_flattened().to_vec())
         .ok_or("frame buffer size mismatch")?;
     img.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;

@@ -9,11 +9,13 @@ use std::time::Instant;
 
 use clap::Args;
 use raylab_core::method::Method;
-use raylab_core::render::{RenderSettings, render};
+use raylab_core::render::{RenderSettings, StageTimes, render};
 use raylab_core::scene::{Camera, PointLight, Scene};
+use raylab_core::shadow::Shadows;
 use raylab_core::stats::TraversalStats;
 use raylab_core::trace::{TraceOptions, Tracer};
 
+use super::shading_tables::{ShadingRun, Subject};
 use crate::args::{KdArgs, SceneArgs, in_range};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene};
@@ -45,18 +47,50 @@ pub struct TablesArgs {
     /// Also write the markdown to this file.
     #[arg(long)]
     markdown: Option<PathBuf>,
+    /// Which tables: primary (4.1-4.5), shading (5.1, 4.6, 3.1 and image quality) or all.
+    #[arg(long, value_enum, default_value_t = Part::All)]
+    part: Part,
+    /// Built-in scenes of the shading tables (the scene given with --scene is measured too).
+    #[arg(long, value_delimiter = ',', default_value = "atrium")]
+    shading_builtins: Vec<String>,
+    /// Edge of the square image-quality renders (the 1024-sample reference is slow).
+    #[arg(long, default_value_t = 256, value_parser = in_range(16, 4096))]
+    quality_size: u64,
+    /// Write the image-quality renders as PNG into this folder.
+    #[arg(long)]
+    images: Option<PathBuf>,
+}
+
+/// A part of the tables.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Part {
+    /// Tables 4.1-4.5: primary rays per traversal method and tile.
+    Primary,
+    /// Tables 5.1, 4.6 and 3.1 and the image-quality table: shadows, reflections and refractions.
+    Shading,
+    /// Both.
+    All,
 }
 
 /// One measured configuration.
 #[derive(Clone, Copy)]
-struct Cell {
-    fps: f64,
-    n: f64,
-    i: f64,
-    culled: f64,
+pub struct Cell {
+    /// Frames per second from the median frame time.
+    pub fps: f64,
+    /// The thesis's N, nodes per packet.
+    pub n: f64,
+    /// The thesis's I, triangle tests per packet.
+    pub i: f64,
+    /// Culled packet visits in percent.
+    pub culled: f64,
+    /// Stage times of the last frame.
+    pub stages: StageTimes,
+    /// Shadow-cache hit rate of the last frame.
+    pub cache_hit_rate: f64,
 }
 
-fn measure(
+/// Renders one warm-up frame and `reps` timed ones.
+pub fn measure(
     scene: &Scene,
     tracer: &Tracer,
     cam: &Camera,
@@ -67,6 +101,7 @@ fn measure(
 ) -> Cell {
     let mut times = Vec::new();
     let mut stats = TraversalStats::default();
+    let mut stages = StageTimes::default();
     pool.install(|| {
         render(scene, tracer, cam, light, s);
         for _ in 0..reps {
@@ -74,6 +109,7 @@ fn measure(
             let f = render(scene, tracer, cam, light, s);
             times.push(t0.elapsed().as_secs_f64());
             stats = f.stats;
+            stages = f.stages;
         }
     });
     times.sort_by(f64::total_cmp);
@@ -83,6 +119,8 @@ fn measure(
         n: stats.nodes_per_packet(),
         i: stats.isects_per_packet(),
         culled: if tested == 0 { 0.0 } else { 100.0 * stats.packets_culled as f64 / tested as f64 },
+        stages,
+        cache_hit_rate: stats.cache_hit_rate(),
     }
 }
 
@@ -94,26 +132,38 @@ fn pct(a: f64, b: f64) -> String {
 pub fn run(a: &TablesArgs) -> Result<(), String> {
     let env = Environment::detect();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string())?;
-    let mut scenes: Vec<(String, Scene, Camera, PointLight)> = Vec::new();
-    for name in &a.builtins {
+    // Each scene with whether the primary and the shading tables measure it.
+    let mut scenes: Vec<(String, Scene, Camera, PointLight, bool, bool)> = Vec::new();
+    let primary = a.part != Part::Shading;
+    let shading = a.part != Part::Primary;
+    let mut names: Vec<&String> = Vec::new();
+    if primary {
+        names.extend(&a.builtins);
+    }
+    if shading {
+        names.extend(a.shading_builtins.iter().filter(|n| !names.contains(n)).collect::<Vec<_>>());
+    }
+    for name in names.iter().copied().filter(|n| **n != a.view.scene) {
         let args = SceneArgs::named(name);
         let (scene, _) = load_scene(&args.source())?;
         let (cam, light) = args.camera_and_light(&scene)?;
-        scenes.push((name.clone(), scene, cam, light));
+        let (p, sh) = (primary && a.builtins.contains(name), shading && a.shading_builtins.contains(name));
+        scenes.push((name.clone(), scene, cam, light, p, sh));
     }
-    if !a.builtins.contains(&a.view.scene) {
+    {
         let (scene, _) = load_scene(&a.view.source())?;
         let (cam, light) = a.view.camera_and_light(&scene)?;
         let s = &a.view.scene;
         let name = std::path::Path::new(s).file_stem().map_or(s.clone(), |x| x.to_string_lossy().into_owned());
-        scenes.push((name, scene, cam, light));
+        scenes.push((name, scene, cam, light, primary, shading));
     }
     let tiles = [4u32, 8, 16, 32];
     let settings = |tile: u32| RenderSettings {
         width: a.width as u32,
         height: a.height as u32,
         tile,
-        shadows: false,
+        shadows: Shadows::None,
+        max_depth: 0,
         ..Default::default()
     };
     let params = a.kd.params()?;
@@ -128,7 +178,7 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
         mft_cone: Vec<Cell>,
     }
     let mut rows = Vec::new();
-    for (name, scene, cam, light) in &scenes {
+    for (name, scene, cam, light, ..) in scenes.iter().filter(|s| s.4) {
         let tree = build_tree(scene, &params, a.threads as usize)?;
         let tracer = |method, cull| Tracer::new(&tree, None, TraceOptions { method, cull, ..Default::default() });
         let m = |method: Method, tile: u32, cull: bool| {
@@ -150,99 +200,133 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
     let cmd: Vec<String> = std::env::args().collect();
     let _ = writeln!(md, "Machine and build: {}.", env.line());
     let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
-    let _ = writeln!(
-        md,
-        "\n{}x{}, {} threads, primary rays with the simple shading (one point light, N.L, attenuation), no \
-         shadows; FPS from the median of {} frames.",
-        a.width, a.height, a.threads, a.reps
-    );
-    let cells = |c: &Cell| format!("{:.1} | {:.2} | {:.2}", c.fps, c.n, c.i);
-    let _ = writeln!(md, "\n**Table 4.1**: 2x2 packets and single frustums (FPS, N, I).\n");
-    let _ = write!(md, "| scene | packet 2x2 FPS | N | I |");
-    for t in tiles {
-        let _ = write!(md, " frustum {t}x{t} FPS | N | I |");
-    }
-    let _ = writeln!(md, "\n|---|{}", "---:|".repeat(3 + 3 * tiles.len()));
-    for r in &rows {
-        let _ = write!(md, "| {} | {} |", r.name, cells(&r.packet));
-        for c in &r.frustum {
-            let _ = write!(md, " {} |", cells(c));
-        }
-        let _ = writeln!(md);
-    }
-    let _ = writeln!(md, "\n**Table 4.2**: packet/leaf culling, frustum 8x8.\n");
-    let _ = writeln!(md, "| scene | FPS with culling | FPS without | frame-rate change | packet/leaf visits culled |");
-    let _ = writeln!(md, "|---|---:|---:|---:|---:|");
-    for r in &rows {
-        let (on, off) = (r.frustum[1], r.nocull8);
+    if primary {
         let _ = writeln!(
             md,
-            "| {} | {:.1} | {:.1} | {} | {:.1}% |",
-            r.name,
-            on.fps,
-            off.fps,
-            pct(on.fps, off.fps),
-            on.culled
+            "\n{}x{}, {} threads, primary rays with the simple shading (one point light, N.L, attenuation), no \
+             shadows, no secondary rays; FPS from the median of {} frames.",
+            a.width, a.height, a.threads, a.reps
         );
-    }
-    let _ = writeln!(md, "\n**Table 4.3**: MFT (FPS, N, I and change against the single frustum at the same tile).\n");
-    let _ = writeln!(md, "| scene | tile | FPS | N | I | % FPS | % N | % I |");
-    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|");
-    for r in &rows {
-        for (k, t) in tiles.iter().enumerate() {
-            let (m, f) = (r.mft[k], r.frustum[k]);
+        let cells = |c: &Cell| format!("{:.1} | {:.2} | {:.2}", c.fps, c.n, c.i);
+        let _ = writeln!(md, "\n**Table 4.1**: 2x2 packets and single frustums (FPS, N, I).\n");
+        let _ = write!(md, "| scene | packet 2x2 FPS | N | I |");
+        for t in tiles {
+            let _ = write!(md, " frustum {t}x{t} FPS | N | I |");
+        }
+        let _ = writeln!(md, "\n|---|{}", "---:|".repeat(3 + 3 * tiles.len()));
+        for r in &rows {
+            let _ = write!(md, "| {} | {} |", r.name, cells(&r.packet));
+            for c in &r.frustum {
+                let _ = write!(md, " {} |", cells(c));
+            }
+            let _ = writeln!(md);
+        }
+        let _ = writeln!(md, "\n**Table 4.2**: packet/leaf culling, frustum 8x8.\n");
+        let _ =
+            writeln!(md, "| scene | FPS with culling | FPS without | frame-rate change | packet/leaf visits culled |");
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|");
+        for r in &rows {
+            let (on, off) = (r.frustum[1], r.nocull8);
             let _ = writeln!(
                 md,
-                "| {} | {t}x{t} | {} | {} | {} | {} |",
+                "| {} | {:.1} | {:.1} | {} | {:.1}% |",
                 r.name,
-                cells(&m),
-                pct(m.fps, f.fps),
-                pct(m.n, f.n),
-                pct(m.i, f.i)
+                on.fps,
+                off.fps,
+                pct(on.fps, off.fps),
+                on.culled
             );
         }
-    }
-    let _ = writeln!(md, "\n**Table 4.4**: peak frame rates.\n");
-    let _ = writeln!(md, "| scene | MFT FPS | MFT tile | non-MFT FPS | non-MFT method and tile | MFT / non-MFT |");
-    let _ = writeln!(md, "|---|---:|---:|---:|---|---:|");
-    for r in &rows {
-        let (bi, bm) = r.mft.iter().enumerate().max_by(|x, y| x.1.fps.total_cmp(&y.1.fps)).expect("tiles");
-        let mut best = (r.packet.fps, "packet 2x2".to_string());
-        for (k, f) in r.frustum.iter().enumerate() {
-            if f.fps > best.0 {
-                best = (f.fps, format!("frustum {0}x{0}", tiles[k]));
-            }
-        }
-        let _ = writeln!(
-            md,
-            "| {} | {:.1} | {t}x{t} | {:.1} | {} | {:.2}x |",
-            r.name,
-            bm.fps,
-            best.0,
-            best.1,
-            bm.fps / best.0,
-            t = tiles[bi]
-        );
-    }
-    let _ = writeln!(md, "\n**Table 4.5**: cones (single cone and MFT over four cones) against the single frustum.\n");
-    let _ = writeln!(md, "| scene | method | tile | FPS | N | I | % FPS | % N | % I |");
-    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|---:|---:|");
-    for r in &rows {
-        for (label, v) in [("cone", &r.cone), ("MFT cone", &r.mft_cone)] {
-            for (k, c) in v.iter().enumerate() {
-                let f = r.frustum[k];
-                let t = tiles[k];
+        let _ =
+            writeln!(md, "\n**Table 4.3**: MFT (FPS, N, I and change against the single frustum at the same tile).\n");
+        let _ = writeln!(md, "| scene | tile | FPS | N | I | % FPS | % N | % I |");
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|");
+        for r in &rows {
+            for (k, t) in tiles.iter().enumerate() {
+                let (m, f) = (r.mft[k], r.frustum[k]);
                 let _ = writeln!(
                     md,
-                    "| {} | {label} | {t}x{t} | {} | {} | {} | {} |",
+                    "| {} | {t}x{t} | {} | {} | {} | {} |",
                     r.name,
-                    cells(c),
-                    pct(c.fps, f.fps),
-                    pct(c.n, f.n),
-                    pct(c.i, f.i)
+                    cells(&m),
+                    pct(m.fps, f.fps),
+                    pct(m.n, f.n),
+                    pct(m.i, f.i)
                 );
             }
         }
+        let _ = writeln!(md, "\n**Table 4.4**: peak frame rates.\n");
+        let _ = writeln!(md, "| scene | MFT FPS | MFT tile | non-MFT FPS | non-MFT method and tile | MFT / non-MFT |");
+        let _ = writeln!(md, "|---|---:|---:|---:|---|---:|");
+        for r in &rows {
+            let (bi, bm) = r.mft.iter().enumerate().max_by(|x, y| x.1.fps.total_cmp(&y.1.fps)).expect("tiles");
+            let mut best = (r.packet.fps, "packet 2x2".to_string());
+            for (k, f) in r.frustum.iter().enumerate() {
+                if f.fps > best.0 {
+                    best = (f.fps, format!("frustum {0}x{0}", tiles[k]));
+                }
+            }
+            let _ = writeln!(
+                md,
+                "| {} | {:.1} | {t}x{t} | {:.1} | {} | {:.2}x |",
+                r.name,
+                bm.fps,
+                best.0,
+                best.1,
+                bm.fps / best.0,
+                t = tiles[bi]
+            );
+        }
+        let _ =
+            writeln!(md, "\n**Table 4.5**: cones (single cone and MFT over four cones) against the single frustum.\n");
+        let _ = writeln!(md, "| scene | method | tile | FPS | N | I | % FPS | % N | % I |");
+        let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|---:|---:|");
+        for r in &rows {
+            for (label, v) in [("cone", &r.cone), ("MFT cone", &r.mft_cone)] {
+                for (k, c) in v.iter().enumerate() {
+                    let f = r.frustum[k];
+                    let t = tiles[k];
+                    let _ = writeln!(
+                        md,
+                        "| {} | {label} | {t}x{t} | {} | {} | {} | {} |",
+                        r.name,
+                        cells(c),
+                        pct(c.fps, f.fps),
+                        pct(c.n, f.n),
+                        pct(c.i, f.i)
+                    );
+                }
+            }
+        }
+    }
+    if shading {
+        let _ = writeln!(md, "\n### Shadows, reflections and refractions (thesis Tables 5.1, 4.6, 3.1)");
+        let run = ShadingRun {
+            size: (a.width as u32, a.height as u32),
+            quality_size: (a.quality_size as u32, a.quality_size as u32),
+            reps: a.reps,
+            pool: &pool,
+            images: a.images.as_deref(),
+            tile: 16,
+        };
+        let mut trees = Vec::new();
+        for (name, scene, ..) in scenes.iter().filter(|s| s.5) {
+            eprintln!("measuring shading on {name} ({} triangles)", scene.triangle_count());
+            trees.push(build_tree(scene, &params, a.threads as usize)?);
+        }
+        let subjects: Vec<Subject> = scenes
+            .iter()
+            .filter(|s| s.5)
+            .zip(&trees)
+            .map(|((name, scene, camera, light, ..), tree)| Subject {
+                name,
+                scene,
+                tree,
+                camera: *camera,
+                light: *light,
+            })
+            .collect();
+        run.write(&subjects, &mut md)?;
     }
     print!("{md}");
     if let Some(p) = &a.markdown {

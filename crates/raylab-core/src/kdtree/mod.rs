@@ -2,6 +2,7 @@
 
 mod build;
 mod clip;
+mod edge_width;
 pub mod frustum;
 pub mod mft;
 pub mod mono;

@@ -17,7 +17,7 @@ use crate::triangle::RayShear;
 use super::{KdParams, KdTree};
 
 /// What a leaf visitor tells the traversal.
-enum Next {
+pub(super) enum Next {
     /// Keep going; stack entries that start beyond the given distance are skipped.
     Continue(f32),
     /// Stop the traversal.
@@ -62,26 +62,44 @@ impl KdTree {
 
     /// True when anything blocks `ray` in `(tmin, tmax]`; stops at the first blocker found.
     pub fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        self.occluder(ray, stats).is_some()
+    }
+
+    /// The first blocker found along `ray` in `(tmin, tmax]` (not necessarily the nearest), for the shadow
+    /// cache.
+    pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         let shear = RayShear::new(ray);
-        let mut hit = false;
+        let mut blocker = None;
         let mut tests = 0u64;
         self.traverse(ray, stats, |ids, _, _| {
             for &id in &self.tri_ids()[ids] {
                 tests += 1;
                 if shear.intersect(self.triangles().get(id), ray.tmin, ray.tmax).is_some() {
-                    hit = true;
+                    blocker = Some(id);
                     return Next::Stop;
                 }
             }
             Next::Continue(ray.tmax)
         });
         stats.isect_tests += tests;
-        hit
+        blocker
+    }
+
+    /// True when triangle `tri` blocks `ray` in `(tmin, tmax]` (one test, not counted).
+    pub fn blocks(&self, ray: &Ray, tri: u32) -> bool {
+        (tri as usize) < self.triangles().len()
+            && ray.is_valid()
+            && RayShear::new(ray).intersect(self.triangles().get(tri), ray.tmin, ray.tmax).is_some()
     }
 
     /// Walks the leaves that `ray` crosses, front to back, calling `leaf(ids, t_near, t_far)` for each.
     #[inline(always)]
-    fn traverse(&self, ray: &Ray, stats: &mut TraversalStats, mut leaf: impl FnMut(Range<usize>, f32, f32) -> Next) {
+    pub(super) fn traverse(
+        &self,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+        mut leaf: impl FnMut(Range<usize>, f32, f32) -> Next,
+    ) {
         stats.rays += 1;
         stats.packets += 1;
         if self.triangles().is_empty() || !ray.is_valid() {

@@ -1,15 +1,19 @@
 //! The tile renderer: the image is cut into square tiles that rayon threads take in turn (thesis chapter 6),
-//! each traced in the chosen [`RayOrder`] and shaded with [`shade`], or drawn as one of the diagnostic
-//! [`FrameView`]s.
+//! each traced in the chosen [`RayOrder`], lit under the chosen [`Shadows`] technique and shaded with the
+//! fixed-function materials, reflections and refractions included ([`shade`]), or drawn as one of the
+//! diagnostic [`FrameView`]s.
 
 mod order;
 pub mod shade;
 mod stages;
 mod view;
+mod visibility;
+mod whitted;
 
 pub use order::RayOrder;
 pub use stages::StageTimes;
 pub use view::{FrameView, depth_grey, heat_color};
+pub use visibility::{ShadowScratch, ShadowTracer};
 
 use std::time::Instant;
 
@@ -20,6 +24,7 @@ use serde::{Deserialize, Serialize};
 use crate::method::Method;
 use crate::ray::{Hit, Ray};
 use crate::scene::{Camera, CameraRaster, PointLight, Scene};
+use crate::shadow::Shadows;
 use crate::stats::TraversalStats;
 use crate::trace::Tracer;
 use shade::to_display;
@@ -35,8 +40,10 @@ pub struct RenderSettings {
     pub tile: u32,
     /// Pixel order inside a tile.
     pub order: RayOrder,
-    /// Trace hard shadows.
-    pub shadows: bool,
+    /// The shadow technique.
+    pub shadows: Shadows,
+    /// Reflection and refraction bounces after the primary hit (0: primary rays only).
+    pub max_depth: u32,
     /// What the frame shows.
     pub view: FrameView,
     /// Value at the hot end of the heat maps; `None` scales each frame to its own maximum.
@@ -50,11 +57,19 @@ impl Default for RenderSettings {
             height: 512,
             tile: 16,
             order: RayOrder::Scanline,
-            shadows: true,
+            shadows: Shadows::Hard,
+            max_depth: RenderSettings::DEFAULT_DEPTH,
             view: FrameView::Shaded,
             heat_max: None,
         }
     }
+}
+
+impl RenderSettings {
+    /// Default reflection and refraction depth (as RTTest's demo scenes).
+    pub const DEFAULT_DEPTH: u32 = 3;
+    /// Deepest recursion accepted; every level can double the rays.
+    pub const MAX_DEPTH: u32 = 16;
 }
 
 /// A rendered image and the work it took.
@@ -66,7 +81,7 @@ pub struct Frame {
     pub height: u32,
     /// Display-ready RGBA8 pixels (gamma 2.2), row-major from the top left.
     pub rgba: Vec<[u8; 4]>,
-    /// Counters of primary and shadow rays together.
+    /// Counters of primary, secondary and shadow rays together.
     pub stats: TraversalStats,
     /// Time per stage, summed over threads.
     pub stages: StageTimes,
@@ -85,13 +100,12 @@ struct TileOut {
     stages: StageTimes,
 }
 
-/// Renders `scene` from `camera` lit by `light`, tracing primary and shadow rays tile by tile with `tracer`
-/// (so the traversal method changes the speed, never the pixels). The work runs on the current rayon pool
+/// Renders `scene` from `camera` lit by `light`, tracing primary, secondary and shadow rays tile by tile with
+/// `tracer` (so the traversal method changes the speed, never the pixels). The work runs on the current rayon pool
 /// (install a pool to choose the thread count).
 pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight, settings: &RenderSettings) -> Frame {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     let tile = settings.tile.max(1);
-    let bounds = scene.bounds();
     // Single rays are traced in the chosen order; packet methods need the tile's pixels row by row.
     let order = if tracer.options.method.uses_packets() { RayOrder::Scanline } else { settings.order };
     let ctx = TileContext {
@@ -101,7 +115,7 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
         light,
         settings,
         width: w,
-        epsilon: if bounds.is_empty() { 0.0 } else { 1e-4 * bounds.diagonal() },
+        epsilon: surface_epsilon(scene),
         order,
         offsets: order.offsets(tile, tile),
     };
@@ -126,6 +140,12 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
         stages += t.stages;
     }
     Frame { width: w, height: h, rgba, stats, stages, range }
+}
+
+/// How far secondary and shadow rays start off a surface: 1e-4 of the scene's diagonal.
+pub fn surface_epsilon(scene: &Scene) -> f32 {
+    let bounds = scene.bounds();
+    if bounds.is_empty() { 0.0 } else { 1e-4 * bounds.diagonal() }
 }
 
 /// The ends of a scalar view's colour scale: nearest and farthest hit for depth, zero and the largest (or the
@@ -175,17 +195,22 @@ struct TileContext<'a> {
     offsets: Vec<(u32, u32)>,
 }
 
-/// Buffers of one block of rays, reused from block to block of a tile.
+/// Buffers of one block of rays, reused from block to block of a tile, and the tile's shadow state.
 #[derive(Default)]
 struct Scratch {
     pixels: Vec<(u32, u32)>,
     rays: Vec<Option<Ray>>,
     hits: Vec<Option<Hit>>,
-    shadow: Vec<Option<Ray>>,
-    blocked: Vec<bool>,
+    seeds: Vec<u32>,
+    shadow: ShadowScratch,
 }
 
 impl TileContext<'_> {
+    /// The shadow tracer of this frame.
+    fn shadows(&self) -> ShadowTracer<'_> {
+        ShadowTracer { tracer: self.tracer, light: self.light, shadows: self.settings.shadows, epsilon: self.epsilon }
+    }
+
     /// Renders the `tw x th` tile at `(x0, y0)`. Heat maps trace it unit by unit so that each unit's counters
     /// can be shared among its own pixels; the units are exactly the pieces the method traces anyway.
     fn tile(&self, x0: u32, y0: u32, tw: u32, th: u32) -> TileOut {
@@ -231,7 +256,7 @@ impl TileContext<'_> {
         out: &mut TileOut,
         sc: &mut Scratch,
     ) {
-        let (scene, light, settings) = (self.scene, &self.light, self.settings);
+        let (scene, settings) = (self.scene, self.settings);
         let t0 = Instant::now();
         sc.pixels.clear();
         sc.pixels.extend(offsets.map(|(dx, dy)| (x0 + dx, y0 + dy)));
@@ -242,23 +267,18 @@ impl TileContext<'_> {
         sc.hits.clear();
         sc.hits.resize(n, None);
         self.tracer.intersect_tile(&sc.rays, rw, rh, &mut sc.hits, &mut out.stats);
-        let t1 = Instant::now();
+        out.stages.primary += t0.elapsed().as_secs_f64();
 
-        // Only the shaded picture and the heat maps (which count the shadow work) need shadow rays.
-        let shadows =
-            settings.shadows && matches!(settings.view, FrameView::Shaded | FrameView::Nodes | FrameView::Isects);
-        sc.shadow.clear();
-        sc.shadow.extend(sc.rays.iter().zip(&sc.hits).map(|(r, h)| match (r, h) {
-            (Some(r), Some(h)) if shadows => shade::shadow_ray(scene, r, h, light, self.epsilon),
-            _ => None,
-        }));
-        sc.blocked.clear();
-        sc.blocked.resize(n, false);
-        if sc.shadow.iter().any(Option::is_some) {
-            self.tracer.occluded_tile(&sc.shadow, rw, rh, Some(light.position), &mut sc.blocked, &mut out.stats);
-        }
-        let t2 = Instant::now();
-
+        let colors = match settings.view {
+            FrameView::Normals | FrameView::Depth => Vec::new(),
+            _ => {
+                sc.seeds.clear();
+                sc.seeds.extend(sc.pixels.iter().map(|&(x, y)| y * self.width + x));
+                let layer = whitted::Layer { rays: &sc.rays, hits: &sc.hits, dims: (rw, rh), seeds: &sc.seeds };
+                self.shade_layer(layer, 0, out, &mut sc.shadow)
+            }
+        };
+        let t = Instant::now();
         out.pixels.extend(sc.pixels.iter().enumerate().map(|(i, &(x, y))| {
             let index = y * self.width + x;
             let (Some(r), Some(hit)) = (&sc.rays[i], &sc.hits[i]) else {
@@ -266,18 +286,11 @@ impl TileContext<'_> {
             };
             let c = match settings.view {
                 FrameView::Normals => shade::facing_normal(scene, r, hit) * 0.5 + Vec3::splat(0.5),
-                _ => {
-                    let visible = !shadows || (sc.shadow[i].is_some() && !sc.blocked[i]);
-                    shade::shade(scene, r, hit, light, visible)
-                }
+                FrameView::Depth => Vec3::ZERO,
+                _ => colors[i],
             };
             (index, [to_display(c.x), to_display(c.y), to_display(c.z), 255], hit.t)
         }));
-        let t3 = Instant::now();
-        out.stages += StageTimes {
-            primary: (t1 - t0).as_secs_f64(),
-            shadow: (t2 - t1).as_secs_f64(),
-            shading: (t3 - t2).as_secs_f64(),
-        };
+        out.stages.shading += t.elapsed().as_secs_f64();
     }
 }

@@ -134,16 +134,3 @@ impl Material {
         }
     }
 }
-
-/// A texture in linear RGB, row-major from the top-left texel.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Texture {
-    /// Name or path, for messages.
-    pub name: String,
-    /// Width in texels (at least 1).
-    pub width: u32,
-    /// Height in texels (at least 1).
-    pub height: u32,
-    /// `width * height` linear RGB texels.
-    pub texels: Vec<Vec3>,
-}

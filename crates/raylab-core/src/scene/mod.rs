@@ -6,10 +6,12 @@
 mod camera;
 mod light;
 mod material;
+mod texture;
 
 pub use camera::{Camera, CameraError, CameraRaster, View};
 pub use light::PointLight;
-pub use material::{Material, MaterialKind, Texture, TextureId};
+pub use material::{Material, MaterialKind, TextureId};
+pub use texture::{Texture, WrapMode};
 
 use glam::{DVec3, Vec2, Vec3};
 

@@ -16,6 +16,7 @@ use crate::packet::{Cone, Cone4};
 use crate::packet::{Frustum, PacketTile};
 use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
+use crate::shadow::EdgeWidth;
 use crate::stats::TraversalStats;
 
 /// How rays are traced. Serialises into run reports (the backend by its name).
@@ -72,6 +73,41 @@ impl<'a> Tracer<'a> {
         Self { tree, reference, options }
     }
 
+    /// The same tracer with another traversal method (the brute-force reference stays the reference).
+    pub fn with_method(&self, method: Method) -> Tracer<'a> {
+        let method = if self.options.method == Method::Reference { Method::Reference } else { method };
+        Tracer { tree: self.tree, reference: self.reference, options: TraceOptions { method, ..self.options } }
+    }
+
+    /// The first blocker found along a single ray (for the shadow cache).
+    pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
+        match self.options.method {
+            Method::Reference => self.reference().occluder(ray, stats),
+            _ => self.tree.occluder(ray, stats),
+        }
+    }
+
+    /// True when triangle `tri` blocks `ray`.
+    pub fn blocks(&self, ray: &Ray, tri: u32) -> bool {
+        match self.options.method {
+            Method::Reference => self.reference().blocks(ray, tri),
+            _ => self.tree.blocks(ray, tri),
+        }
+    }
+
+    /// The edge-width occlusion of a single shadow ray (thesis Listing 5.1). Edge-width rays are traced one
+    /// at a time by every method: the kd-tree kernel, or the brute-force reference for [`Method::Reference`].
+    pub fn edge_width(&self, ray: &Ray, state: &mut EdgeWidth, stats: &mut TraversalStats) -> f32 {
+        match self.options.method {
+            Method::Reference => self.reference().edge_width(ray, state, stats),
+            _ => self.tree.edge_width(ray, state, stats),
+        }
+    }
+
+    fn reference(&self) -> &'a BruteForce {
+        self.reference.expect("the reference method needs a BruteForce")
+    }
+
     /// Closest hits of a `width x height` tile of rays (row-major; `None` where no ray is traced).
     pub fn intersect_tile(
         &self,
@@ -89,7 +125,7 @@ impl<'a> Tracer<'a> {
                 }
             }
             Method::Reference => {
-                let bf = self.reference.expect("the reference method needs a BruteForce");
+                let bf = self.reference();
                 for (o, r) in out.iter_mut().zip(rays) {
                     *o = r.and_then(|r| bf.intersect(&r, stats));
                 }
@@ -120,7 +156,7 @@ impl<'a> Tracer<'a> {
                 }
             }
             Method::Reference => {
-                let bf = self.reference.expect("the reference method needs a BruteForce");
+                let bf = self.reference();
                 for (o, r) in out.iter_mut().zip(rays) {
                     *o = r.is_some_and(|r| bf.occluded(&r, stats));
                 }

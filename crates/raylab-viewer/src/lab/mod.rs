@@ -499,7 +499,9 @@ mod tests {
 
     use super::*;
     use crate::loader::load_now;
-    use crate::settings::{RenderMode, Shadows};
+    use raylab_core::shadow::Shadows;
+
+    use crate::settings::RenderMode;
 
     fn lab(method: Method) -> Lab {
         let kd = KdParams::default();
@@ -509,6 +511,7 @@ mod tests {
             trace: TraceOptions { method, ..TraceOptions::default() },
             tile: 8,
             shadows: Shadows::Hard,
+            depth: 3,
             order: RayOrder::Scanline,
             show: FrameView::Shaded,
             heat_max: None,

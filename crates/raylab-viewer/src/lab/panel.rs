@@ -8,7 +8,10 @@ use raylab_simd::Backend;
 use super::{Lab, Shot};
 use crate::camera_path::CameraPath;
 use crate::cli::value_name;
-use crate::settings::{RenderMode, Shadows, ViewerSettings};
+use raylab_core::render::RenderSettings;
+use raylab_core::shadow::{SampleBound, ShadowKind, Shadows};
+
+use crate::settings::{RenderMode, ViewerSettings};
 
 /// Draws the panel.
 pub fn show(lab: &mut Lab, ui: &mut egui::Ui) {
@@ -148,6 +151,7 @@ fn camera_section(lab: &mut Lab, ui: &mut egui::Ui) {
 
 fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
     let before = lab.settings;
+    let light_radius = lab.light.radius;
     let s = &mut lab.settings;
     egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| {
         egui::ComboBox::from_label("mode").selected_text(value_name(&s.mode)).show_ui(ui, |ui| {
@@ -179,10 +183,7 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
                 ui.selectable_value(&mut s.trace.backend, b, b.name());
             }
         });
-        egui::ComboBox::from_label("shadows").selected_text(value_name(&s.shadows)).show_ui(ui, |ui| {
-            ui.selectable_value(&mut s.shadows, Shadows::None, "none");
-            ui.selectable_value(&mut s.shadows, Shadows::Hard, "hard");
-        });
+        shadow_controls(ui, s, light_radius);
         ui.add_enabled(
             frustums && s.shadows == Shadows::Hard,
             egui::Slider::new(&mut s.trace.shadow_spread_limit, 0.0..=0.5).text("shadow spread limit"),
@@ -206,6 +207,56 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
     if lab.settings != before {
         lab.dirty = true;
     }
+}
+
+/// The shadow technique, its parameters, and the reflection depth.
+fn shadow_controls(ui: &mut egui::Ui, s: &mut ViewerSettings, light_radius: f32) {
+    // Parameters carry over when switching technique: the edge radius and leak fix, the sample bound.
+    let (radius, leak_fix, bound) = match s.shadows {
+        Shadows::EdgeWidth { radius, leak_fix } => (radius, leak_fix, SampleBound::default()),
+        Shadows::MultiSample { bound, .. } => (light_radius, false, bound),
+        _ => (light_radius, false, SampleBound::default()),
+    };
+    let kinds = [
+        (ShadowKind::None, "none"),
+        (ShadowKind::Hard, "hard"),
+        (ShadowKind::Cached, "hard, shadow cache"),
+        (ShadowKind::Edge, "edge width (soft)"),
+        (ShadowKind::Samples(4), "4 samples"),
+        (ShadowKind::Samples(8), "8 samples"),
+        (ShadowKind::Samples(16), "16 samples"),
+        (ShadowKind::Samples(32), "32 samples"),
+    ];
+    let current = s.shadows.name();
+    let label = kinds.iter().find(|(k, _)| k.with(radius, leak_fix, bound).name() == current).map_or("?", |k| k.1);
+    egui::ComboBox::from_label("shadows").selected_text(label).show_ui(ui, |ui| {
+        for (kind, name) in kinds {
+            let option = kind.with(radius, leak_fix, bound);
+            if ui.selectable_label(option.name() == current, name).clicked() && option.name() != current {
+                s.shadows = option;
+            }
+        }
+    });
+    match &mut s.shadows {
+        Shadows::EdgeWidth { radius, leak_fix } => {
+            let top = (light_radius * 8.0).max(1.0);
+            ui.add(egui::Slider::new(radius, 0.0..=top).text("edge radius R"))
+                .on_hover_text("edge width at which a point is fully shadowed; wider R, wider penumbra");
+            ui.checkbox(leak_fix, "light-leak fix")
+                .on_hover_text("pair only entry and exit triangles that share a vertex");
+        }
+        Shadows::MultiSample { bound, .. } => {
+            egui::ComboBox::from_label("sample bound").selected_text(bound.name()).show_ui(ui, |ui| {
+                for b in SampleBound::ALL {
+                    ui.selectable_value(bound, b, b.name());
+                }
+            });
+            ui.small(format!("light radius {light_radius}"));
+        }
+        _ => {}
+    }
+    ui.add(egui::Slider::new(&mut s.depth, 0..=RenderSettings::MAX_DEPTH.min(8)).text("reflection depth"))
+        .on_hover_text("reflection and refraction bounces after the primary hit");
 }
 
 fn view_section(lab: &mut Lab, ui: &mut egui::Ui) {

@@ -142,10 +142,13 @@ impl Readouts {
             row("N (nodes/packet)", format!("{:.2}", s.nodes_per_packet()));
             row("I (isects/packet)", format!("{:.2}", s.isects_per_packet()));
             row("packets culled", format!("{:.1} %", culled_pct(&s)));
+            if s.cache_lookups > 0 {
+                row("shadow cache hits", format!("{:.1} %", 100.0 * s.cache_hit_rate()));
+            }
             let pct = st.percentages();
-            row("primary rays", format!("{:.2} ms ({:.0} %)", st.primary * 1e3, pct[0]));
-            row("shadow rays", format!("{:.2} ms ({:.0} %)", st.shadow * 1e3, pct[1]));
-            row("shading", format!("{:.2} ms ({:.0} %)", st.shading * 1e3, pct[2]));
+            for ((name, ms), p) in StageTimes::NAMES.iter().zip(st.as_array()).zip(pct) {
+                row(name, format!("{:.2} ms ({p:.0} %)", ms * 1e3));
+            }
             row("upload", format!("{:.3} ms", self.upload_ms.last().copied().unwrap_or(0.0)));
             row("UI", format!("{:.3} ms", self.ui_ms.last().copied().unwrap_or(0.0)));
         });
@@ -182,7 +185,7 @@ impl Readouts {
             n: self.totals.nodes_per_packet(),
             i: self.totals.isects_per_packet(),
             culled_pct: culled_pct(&self.totals),
-            stage_ms_per_frame: [self.stages.primary, self.stages.shadow, self.stages.shading].map(|s| s * 1e3 / n),
+            stage_ms_per_frame: self.stages.as_array().map(|s| s * 1e3 / n),
             upload_ms_mean: mean(&self.upload_ms),
             ui_ms_mean: mean(&self.ui_ms),
             ui_frames: self.ui_ms.len(),
@@ -215,8 +218,8 @@ pub struct StatsReport {
     pub i: f64,
     /// Culled packet share in percent.
     pub culled_pct: f64,
-    /// Mean thread-summed ms per frame of the primary, shadow and shading stages.
-    pub stage_ms_per_frame: [f64; 3],
+    /// Mean thread-summed ms per frame of each stage, in the order of [`StageTimes::NAMES`].
+    pub stage_ms_per_frame: [f64; 5],
     /// Mean CPU ms to upload a traced frame.
     pub upload_ms_mean: f64,
     /// Mean CPU ms to build, encode and submit a UI frame (the upload excluded).

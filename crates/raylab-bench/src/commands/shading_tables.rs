@@ -1,0 +1,237 @@
+//! The shading half of `raylab-bench tables`: thesis Table 5.1 (frame rate per shadow technique), Table 4.6
+//! (16-sample soft shadows bounded by cones or pyramids, light radius 1 and 2), Table 3.1 (where a frame's
+//! time goes, stage by stage), and an image-quality table: each soft technique's RMSE against a 1024-sample
+//! reference, with the images written as PNG.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use raylab_core::kdtree::KdTree;
+use raylab_core::method::Method;
+use raylab_core::render::{Frame, RenderSettings, StageTimes, render};
+use raylab_core::scene::{Camera, PointLight, Scene};
+use raylab_core::shadow::{SampleBound, Shadows};
+use raylab_core::trace::{TraceOptions, Tracer};
+
+use super::tables::{Cell, measure};
+
+/// What the shading tables need besides the scenes.
+pub struct ShadingRun<'a> {
+    /// Frame width and height for the timed tables.
+    pub size: (u32, u32),
+    /// Frame width and height of the image-quality renders (the 1024-sample reference is slow).
+    pub quality_size: (u32, u32),
+    /// Timed frames per configuration.
+    pub reps: u64,
+    /// The pool to render on.
+    pub pool: &'a rayon::ThreadPool,
+    /// Where the image-quality PNGs go, if anywhere.
+    pub images: Option<&'a Path>,
+    /// Tile edge of the primary rays (MFT).
+    pub tile: u32,
+}
+
+/// One scene with its tree, camera and light.
+pub struct Subject<'a> {
+    /// Name for the tables.
+    pub name: &'a str,
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Its kd-tree.
+    pub tree: &'a KdTree,
+    /// The camera.
+    pub camera: Camera,
+    /// The light (its radius is replaced where a table fixes one).
+    pub light: PointLight,
+}
+
+/// Light radius of the soft techniques where the table does not fix one: the scene's own, or 1 (the thesis's
+/// Sponza light) for a point light.
+fn soft_radius(light: &PointLight) -> f32 {
+    if light.radius > 0.0 { light.radius } else { 1.0 }
+}
+
+impl ShadingRun<'_> {
+    fn settings(&self, shadows: Shadows, max_depth: u32, size: (u32, u32)) -> RenderSettings {
+        RenderSettings { width: size.0, height: size.1, tile: self.tile, shadows, max_depth, ..Default::default() }
+    }
+
+    fn timed(&self, s: &Subject, tracer: &Tracer, light: PointLight, shadows: Shadows, depth: u32) -> Cell {
+        measure(s.scene, tracer, &s.camera, light, &self.settings(shadows, depth, self.size), self.pool, self.reps)
+    }
+
+    /// Writes Tables 5.1, 4.6 and 3.1 and the image-quality table for `subjects` into `md`.
+    pub fn write(&self, subjects: &[Subject], md: &mut String) -> Result<(), String> {
+        let (w, h) = self.size;
+        let _ = writeln!(
+            md,
+            "\n{w}x{h}; primary rays by MFT {t}x{t}; FPS from the median of {} frames. Soft techniques use the \
+             light's radius (1 where the scene's light is a point), and the edge radius R equals it.",
+            self.reps,
+            t = self.tile
+        );
+        self.table_5_1(subjects, md);
+        self.table_4_6(subjects, md);
+        self.table_3_1(subjects, md);
+        self.quality(subjects, md)
+    }
+
+    fn tracer<'t>(s: &'t Subject) -> Tracer<'t> {
+        Tracer::new(s.tree, None, TraceOptions { method: Method::Mft, ..TraceOptions::default() })
+    }
+
+    fn table_5_1(&self, subjects: &[Subject], md: &mut String) {
+        let _ = writeln!(
+            md,
+            "\n**Table 5.1**: shadow techniques, primary rays only (no reflections), FPS (and frame time against \
+             hard shadows).\n"
+        );
+        let _ = writeln!(
+            md,
+            "| scene | none | hard | hard + cache (hit rate) | edge width | edge / hard time | 4 samples | 32 \
+             samples (cone) |"
+        );
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|");
+        for s in subjects {
+            let tracer = Self::tracer(s);
+            let light = PointLight { radius: soft_radius(&s.light), ..s.light };
+            let r = light.radius;
+            let cell = |shadows| self.timed(s, &tracer, light, shadows, 0);
+            let none = cell(Shadows::None);
+            let hard = cell(Shadows::Hard);
+            let cached = cell(Shadows::Cached);
+            let edge = cell(Shadows::EdgeWidth { radius: r, leak_fix: false });
+            let ms4 = cell(Shadows::MultiSample { samples: 4, bound: SampleBound::Cone });
+            let ms32 = cell(Shadows::MultiSample { samples: 32, bound: SampleBound::Cone });
+            let _ = writeln!(
+                md,
+                "| {} | {:.1} | {:.1} | {:.1} ({:.0}%) | {:.1} | {:.2}x | {:.2} | {:.2} |",
+                s.name,
+                none.fps,
+                hard.fps,
+                cached.fps,
+                100.0 * cached.cache_hit_rate,
+                edge.fps,
+                hard.fps / edge.fps,
+                ms4.fps,
+                ms32.fps
+            );
+        }
+    }
+
+    fn table_4_6(&self, subjects: &[Subject], md: &mut String) {
+        let _ =
+            writeln!(md, "\n**Table 4.6**: 16 samples per point, bounded by a cone or a pyramid (or plain packets).\n");
+        let _ = writeln!(md, "| scene | light radius | bound | FPS | N | I | cone speed-up |");
+        let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|");
+        for s in subjects {
+            let tracer = Self::tracer(s);
+            for radius in [1.0f32, 2.0] {
+                let light = PointLight { radius, ..s.light };
+                let cells: Vec<(SampleBound, Cell)> = [SampleBound::Cone, SampleBound::Pyramid, SampleBound::Packets]
+                    .into_iter()
+                    .map(|bound| (bound, self.timed(s, &tracer, light, Shadows::MultiSample { samples: 16, bound }, 0)))
+                    .collect();
+                let cone = cells[0].1.fps;
+                for (bound, c) in &cells {
+                    let speedup =
+                        if *bound == SampleBound::Cone { String::new() } else { format!("{:.2}x", cone / c.fps) };
+                    let _ = writeln!(
+                        md,
+                        "| {} | {radius} | {} | {:.2} | {:.2} | {:.2} | {speedup} |",
+                        s.name,
+                        bound.name(),
+                        c.fps,
+                        c.n,
+                        c.i
+                    );
+                }
+            }
+        }
+    }
+
+    fn table_3_1(&self, subjects: &[Subject], md: &mut String) {
+        let _ = writeln!(
+            md,
+            "\n**Table 3.1**: share of the frame per stage, hard shadows, reflections and refractions to depth {} \
+             (thread-summed times; traversal and intersection run inside one kernel call, so they share a row).\n",
+            RenderSettings::DEFAULT_DEPTH
+        );
+        let _ = write!(md, "| scene | FPS |");
+        for name in StageTimes::NAMES {
+            let _ = write!(md, " {name} |");
+        }
+        let _ = writeln!(md, "\n|---|---:|{}", "---:|".repeat(StageTimes::NAMES.len()));
+        for s in subjects {
+            let tracer = Self::tracer(s);
+            let c = self.timed(s, &tracer, s.light, Shadows::Hard, RenderSettings::DEFAULT_DEPTH);
+            let _ = write!(md, "| {} | {:.1} |", s.name, c.fps);
+            for p in c.stages.percentages() {
+                let _ = write!(md, " {p:.1}% |");
+            }
+            let _ = writeln!(md);
+        }
+    }
+
+    fn quality(&self, subjects: &[Subject], md: &mut String) -> Result<(), String> {
+        let (w, h) = self.quality_size;
+        let _ = writeln!(
+            md,
+            "\n**Image quality**: RMSE (8-bit display values, all channels) against 1024 stratified samples per \
+             point, {w}x{h}, primary rays only.\n"
+        );
+        let _ =
+            writeln!(md, "| scene | hard | edge width | edge width, leak fix | 4 samples | 16 samples | 32 samples |");
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|");
+        for s in subjects {
+            let tracer = Self::tracer(s);
+            let light = PointLight { radius: soft_radius(&s.light), ..s.light };
+            let r = light.radius;
+            let shot = |shadows: Shadows| -> Frame {
+                self.pool.install(|| render(s.scene, &tracer, &s.camera, light, &self.settings(shadows, 0, (w, h))))
+            };
+            let reference = shot(Shadows::MultiSample { samples: 1024, bound: SampleBound::Cone });
+            let techniques = [
+                ("hard", Shadows::Hard),
+                ("edge", Shadows::EdgeWidth { radius: r, leak_fix: false }),
+                ("edge-leakfix", Shadows::EdgeWidth { radius: r, leak_fix: true }),
+                ("ms4", Shadows::MultiSample { samples: 4, bound: SampleBound::Cone }),
+                ("ms16", Shadows::MultiSample { samples: 16, bound: SampleBound::Cone }),
+                ("ms32", Shadows::MultiSample { samples: 32, bound: SampleBound::Cone }),
+            ];
+            let _ = write!(md, "| {} |", s.name);
+            for (label, shadows) in techniques {
+                let f = shot(shadows);
+                let _ = write!(md, " {:.2} |", rmse(&f, &reference));
+                if let Some(dir) = self.images {
+                    save(&f, &dir.join(format!("{}-{label}.png", s.name)))?;
+                }
+            }
+            let _ = writeln!(md);
+            if let Some(dir) = self.images {
+                save(&reference, &dir.join(format!("{}-ms1024.png", s.name)))?;
+            }
+        }
+        if let Some(dir) = self.images {
+            let _ = writeln!(md, "\nImages: `{}/<scene>-<technique>.png`.", dir.display());
+        }
+        Ok(())
+    }
+}
+
+/// Root-mean-square difference of two frames' RGB display values.
+fn rmse(a: &Frame, b: &Frame) -> f64 {
+    let sum: f64 =
+        a.rgba.iter().zip(&b.rgba).flat_map(|(p, q)| (0..3).map(move |k| (p[k] as f64 - q[k] as f64).powi(2))).sum();
+    (sum / (3 * a.rgba.len().max(1)) as f64).sqrt()
+}
+
+fn save(f: &Frame, path: &Path) -> Result<(), String> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("--images: cannot create {}: {e}", dir.display()))?;
+    }
+    image::RgbaImage::from_raw(f.width, f.height, f.rgba.as_flattened().to_vec())
+        .ok_or("frame buffer size mismatch")?
+        .save(path)
+        .map_err(|e| format!("--images: cannot write {}: {e}", path.display()))
+}

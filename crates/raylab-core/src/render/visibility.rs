@@ -1,0 +1,113 @@
+//! How much of the light each hit of a layer sees, under the frame's shadow technique ([`Shadows`]).
+//!
+//! Hard shadows go through the frame's traversal method as one tile of segments ending at the light (so the
+//! frustum methods trace them as frustums from the light, as the thesis does); the shadow cache and edge
+//! widths are single-ray techniques; multi-sampling traces each point's samples as one bundle bounded by
+//! packets, a pyramid or a cone.
+
+use crate::ray::{Hit, Ray};
+use crate::scene::{PointLight, Scene};
+use crate::shadow::{EdgeWidth, LightSamples, ShadowCache, Shadows};
+use crate::stats::TraversalStats;
+use crate::trace::Tracer;
+
+use super::shade::{Surface, shadow_ray};
+
+/// Per-tile state of the shadow techniques (the shadow cache, edge-width buffers, light samples), reused from
+/// layer to layer; one per worker task, never shared.
+#[derive(Default)]
+pub struct ShadowScratch {
+    cache: ShadowCache,
+    edge: Option<EdgeWidth>,
+    samples: LightSamples,
+    rays: Vec<Option<Ray>>,
+    blocked: Vec<bool>,
+}
+
+/// Traces the shadow rays of hit points under one technique.
+pub struct ShadowTracer<'a> {
+    /// The tracer (its method traces hard shadows; multi-sampling swaps in the bound's method).
+    pub tracer: &'a Tracer<'a>,
+    /// The light.
+    pub light: PointLight,
+    /// The technique.
+    pub shadows: Shadows,
+    /// How far shadow rays start off the surface, along its geometric normal.
+    pub epsilon: f32,
+}
+
+impl ShadowTracer<'_> {
+    /// The visibility of the light from the hit `hit` of `ray` alone; `seed` jitters light samples.
+    pub fn at_hit(&self, scene: &Scene, ray: &Ray, hit: &Hit, seed: u32, stats: &mut TraversalStats) -> f32 {
+        let surface = [Some(Surface::at(scene, ray, hit))];
+        self.visibility(&surface, (1, 1), &[seed], stats, &mut ShadowScratch::default())[0]
+    }
+
+    /// The visibility in `[0, 1]` of the light from each surface of a `width x height` layer (0 where there is
+    /// no surface or it faces away from the light).
+    pub fn visibility(
+        &self,
+        surfaces: &[Option<Surface>],
+        (width, height): (usize, usize),
+        seeds: &[u32],
+        stats: &mut TraversalStats,
+        sc: &mut ShadowScratch,
+    ) -> Vec<f32> {
+        let light = &self.light;
+        let center = light.position;
+        let eps = self.epsilon;
+        let to_center = |s: &Surface| shadow_ray(s, center, center, eps);
+        match self.shadows {
+            Shadows::None => surfaces.iter().map(|s| if s.is_some() { 1.0 } else { 0.0 }).collect(),
+            Shadows::Hard => {
+                sc.rays.clear();
+                sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(to_center)));
+                sc.blocked.clear();
+                sc.blocked.resize(sc.rays.len(), false);
+                if sc.rays.iter().any(Option::is_some) {
+                    self.tracer.occluded_tile(&sc.rays, width, height, Some(center), &mut sc.blocked, stats);
+                }
+                sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| if r.is_some() && !b { 1.0 } else { 0.0 }).collect()
+            }
+            Shadows::Cached => surfaces
+                .iter()
+                .map(|s| match s.as_ref().and_then(to_center) {
+                    Some(r) if !sc.cache.occluded(self.tracer, &r, stats) => 1.0,
+                    _ => 0.0,
+                })
+                .collect(),
+            Shadows::EdgeWidth { radius, leak_fix } => {
+                let edge = sc.edge.get_or_insert_with(|| EdgeWidth::new(radius, leak_fix));
+                surfaces
+                    .iter()
+                    .map(|s| match s.as_ref().and_then(to_center) {
+                        Some(r) => 1.0 - self.tracer.edge_width(&r, edge, stats),
+                        None => 0.0,
+                    })
+                    .collect()
+            }
+            Shadows::MultiSample { samples, bound } => {
+                let tracer = self.tracer.with_method(bound.method());
+                surfaces
+                    .iter()
+                    .zip(seeds)
+                    .map(|(s, &seed)| {
+                        let Some(s) = s else { return 0.0 };
+                        if to_center(s).is_none() {
+                            return 0.0;
+                        }
+                        sc.samples.generate(center, light.radius, s.point, samples, seed);
+                        sc.rays.clear();
+                        sc.rays.extend(sc.samples.points.iter().map(|&p| shadow_ray(s, center, p, eps)));
+                        sc.blocked.clear();
+                        sc.blocked.resize(sc.rays.len(), false);
+                        let (w, h) = (sc.samples.width as usize, sc.samples.height as usize);
+                        tracer.occluded_tile(&sc.rays, w, h, None, &mut sc.blocked, stats);
+                        let lit = sc.rays.iter().zip(&sc.blocked).filter(|(r, b)| r.is_some() && !**b).count();
+                        lit as f32 / sc.rays.len() as f32
+                    })
+                    .collect()
+            }
+        }
+    }
+}

@@ -1,0 +1,42 @@
+//! The shadow cache (Akenine-Moller and Assarsson, Ray Tracing II, "The Shadow Cache"): any blocker proves a
+//! point is in shadow, and neighbouring shadow rays tend to be blocked by the same triangle, so each shadow
+//! ray first tests the triangle that blocked the previous one.
+
+use crate::ray::Ray;
+use crate::stats::TraversalStats;
+use crate::trace::Tracer;
+
+/// The last blocker found by the shadow rays of one tile (one cache per worker task, so no sharing).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ShadowCache {
+    last: Option<u32>,
+}
+
+impl ShadowCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// True when anything blocks `ray`: the cached triangle is tested first (a lookup, and a hit when it
+    /// blocks), then the ray is traced, and the blocker it finds becomes the cached triangle.
+    pub fn occluded(&mut self, tracer: &Tracer, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        if let Some(tri) = self.last {
+            stats.cache_lookups += 1;
+            stats.isect_tests += 1;
+            if tracer.blocks(ray, tri) {
+                stats.cache_hits += 1;
+                stats.rays += 1;
+                stats.packets += 1;
+                return true;
+            }
+        }
+        match tracer.occluder(ray, stats) {
+            Some(tri) => {
+                self.last = Some(tri);
+                true
+            }
+            None => false,
+        }
+    }
+}
