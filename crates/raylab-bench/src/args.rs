@@ -225,7 +225,7 @@ pub struct ShadeArgs {
     #[arg(long, default_value = "hard")]
     pub shadows: ShadowKind,
     /// How multi-sampled shadows bound each point's samples: packets, pyramid or cone.
-    #[arg(long, default_value = "cone")]
+    #[arg(long, default_value = "packets")]
     pub ms_bound: SampleBound,
     /// Edge width at which a point counts as fully shadowed, in world units (default: the light's radius).
     #[arg(long, value_parser = parse_non_negative)]

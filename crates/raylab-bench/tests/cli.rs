@@ -75,6 +75,12 @@ fn bad_input_is_refused_with_a_clear_error() {
             &["render", "--scene", "arena", "--out", "/nonexistent-dir/x.png", "--width", "8", "--height", "8"],
             "cannot write",
         ),
+        (&["render", "--scene", "arena", "--shadows", "soft"], "unknown shadow technique 'soft'"),
+        (&["render", "--scene", "arena", "--shadows", "ms0"], "between 1 and 4096"),
+        (&["render", "--scene", "arena", "--edge-radius", "-1"], ">= 0"),
+        (&["render", "--scene", "arena", "--light-radius", "nan"], ">= 0"),
+        (&["render", "--scene", "arena", "--depth", "99"], "0..=16"),
+        (&["render", "--scene", "arena", "--ms-bound", "box"], "packets, pyramid or cone"),
         (&["trace", "--scene", "arena", "--kind", "glossy"], "primary, shadow, diffuse"),
         (&["trace", "--scene", "arena", "--method", "warp"], "mono"),
         (&["trace", "--scene", "arena", "--threads", "0"], "1..=1024"),
@@ -109,6 +115,10 @@ fn tables_print_the_thesis_tables() {
             "1",
             "--threads",
             "1",
+            "--quality-size",
+            "16",
+            "--images",
+            "img",
             "--markdown",
             out.to_str().unwrap(),
         ],
@@ -116,8 +126,22 @@ fn tables_print_the_thesis_tables() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let md = std::fs::read_to_string(&out).unwrap();
-    for t in ["Table 4.1", "Table 4.2", "Table 4.3", "Table 4.4", "Table 4.5", "| arena |"] {
+    for t in [
+        "Table 4.1",
+        "Table 4.2",
+        "Table 4.3",
+        "Table 4.4",
+        "Table 4.5",
+        "Table 5.1",
+        "Table 4.6",
+        "Table 3.1",
+        "Image quality",
+        "| arena |",
+    ] {
         assert!(md.contains(t), "missing {t} in:\n{md}");
+    }
+    for technique in ["hard", "edge", "ms4", "ms32", "ms1024"] {
+        assert!(dir.path().join(format!("img/arena-{technique}.png")).is_file(), "no {technique} image");
     }
 }
 
@@ -142,6 +166,35 @@ fn render_is_the_same_for_every_method_and_backend() {
     }
     for (k, img) in images.iter().enumerate().skip(1) {
         assert_eq!(img.as_raw(), images[0].as_raw(), "render {k} differs from mono");
+    }
+}
+
+#[test]
+fn every_shadow_technique_renders_the_same_with_every_method() {
+    let dir = tempfile::tempdir().unwrap();
+    for shadows in [&["--shadows", "edge", "--leak-fix"][..], &["--shadows", "ms8", "--ms-bound", "pyramid"][..]] {
+        let mut images = Vec::new();
+        for method in ["mono", "mft", "cone"] {
+            let out = dir.path().join(format!("{method}.png"));
+            let mut args = vec![
+                "render",
+                "--scene",
+                "atrium",
+                "--width",
+                "40",
+                "--height",
+                "32",
+                "--method",
+                method,
+                "--out",
+                out.to_str().unwrap(),
+            ];
+            args.extend_from_slice(shadows);
+            let o = bench(&args, dir.path());
+            assert!(o.status.success(), "{shadows:?}: {}", stderr(&o));
+            images.push(image::open(&out).unwrap().to_rgba8());
+        }
+        assert!(images.iter().all(|i| i.as_raw() == images[0].as_raw()), "{shadows:?}: methods differ");
     }
 }
 

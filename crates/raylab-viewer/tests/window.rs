@@ -83,7 +83,7 @@ fn reference(method: Method, shadows: ShadowKind, show: FrameView) -> image::Rgb
         height: H,
         tile: TILE,
         order: RayOrder::Scanline,
-        shadows: shadows.with(light.radius, false, SampleBound::Cone),
+        shadows: shadows.with(light.radius, false, SampleBound::default()),
         max_depth: RenderSettings::DEFAULT_DEPTH,
         view: show,
         heat_max: None,

@@ -37,6 +37,25 @@ pub struct ShadowTracer<'a> {
 }
 
 impl ShadowTracer<'_> {
+    /// Hard shadows of a layer: fills `sc.rays` with the segments to the light's centre (`None` where there
+    /// is no surface or it faces away) and `sc.blocked` with their occlusion, traced by the frame's method.
+    fn hard(
+        &self,
+        surfaces: &[Option<Surface>],
+        (width, height): (usize, usize),
+        stats: &mut TraversalStats,
+        sc: &mut ShadowScratch,
+    ) {
+        let center = self.light.position;
+        sc.rays.clear();
+        sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(|s| shadow_ray(s, center, center, self.epsilon))));
+        sc.blocked.clear();
+        sc.blocked.resize(sc.rays.len(), false);
+        if sc.rays.iter().any(Option::is_some) {
+            self.tracer.occluded_tile(&sc.rays, width, height, Some(center), &mut sc.blocked, stats);
+        }
+    }
+
     /// The visibility of the light from the hit `hit` of `ray` alone; `seed` jitters light samples.
     pub fn at_hit(&self, scene: &Scene, ray: &Ray, hit: &Hit, seed: u32, stats: &mut TraversalStats) -> f32 {
         let surface = [Some(Surface::at(scene, ray, hit))];
@@ -60,13 +79,7 @@ impl ShadowTracer<'_> {
         match self.shadows {
             Shadows::None => surfaces.iter().map(|s| if s.is_some() { 1.0 } else { 0.0 }).collect(),
             Shadows::Hard => {
-                sc.rays.clear();
-                sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(to_center)));
-                sc.blocked.clear();
-                sc.blocked.resize(sc.rays.len(), false);
-                if sc.rays.iter().any(Option::is_some) {
-                    self.tracer.occluded_tile(&sc.rays, width, height, Some(center), &mut sc.blocked, stats);
-                }
+                self.hard(surfaces, (width, height), stats, sc);
                 sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| if r.is_some() && !b { 1.0 } else { 0.0 }).collect()
             }
             Shadows::Cached => surfaces
@@ -77,11 +90,16 @@ impl ShadowTracer<'_> {
                 })
                 .collect(),
             Shadows::EdgeWidth { radius, leak_fix } => {
+                // A segment nothing blocks has no crossing and a visibility of 1: the frame's method finds
+                // those as hard shadows, coherently, and only the blocked ones walk the tree for edge widths.
+                self.hard(surfaces, (width, height), stats, sc);
                 let edge = sc.edge.get_or_insert_with(|| EdgeWidth::new(radius, leak_fix));
-                surfaces
+                sc.rays
                     .iter()
-                    .map(|s| match s.as_ref().and_then(to_center) {
-                        Some(r) => 1.0 - self.tracer.edge_width(&r, edge, stats),
+                    .zip(&sc.blocked)
+                    .map(|(r, &blocked)| match r {
+                        Some(r) if blocked => 1.0 - self.tracer.edge_width(r, edge, stats),
+                        Some(_) => 1.0,
                         None => 0.0,
                     })
                     .collect()

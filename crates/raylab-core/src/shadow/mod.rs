@@ -24,12 +24,13 @@ use crate::method::Method;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SampleBound {
-    /// The samples are traced as plain 2x2 packets.
+    /// The samples are traced as plain 2x2 packets: the fastest here (a bundle of a few rays spread over a
+    /// wide light leaves most of its volume unsampled, and a frustum walks all of it; docs/BENCHMARKS.md).
+    #[default]
     Packets,
     /// The samples of a point are bounded by one pyramid frustum.
     Pyramid,
-    /// The samples of a point are bounded by one cone frustum, which fits a spherical light tighter.
-    #[default]
+    /// The samples of a point are bounded by one cone frustum, the shape of a spherical light's samples.
     Cone,
 }
 
