@@ -79,7 +79,7 @@ pub struct SceneArgs {
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub light: Option<Vec3>,
     /// Radius of the spherical light for soft shadows, in world units (defaults to the scene's light).
-    #[arg(long, value_parser = parse_non_negative)]
+    #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true)]
     pub light_radius: Option<f32>,
 }
 
@@ -228,7 +228,7 @@ pub struct ShadeArgs {
     #[arg(long, default_value = "packets")]
     pub ms_bound: SampleBound,
     /// Edge width at which a point counts as fully shadowed, in world units (default: the light's radius).
-    #[arg(long, value_parser = parse_non_negative)]
+    #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true)]
     pub edge_radius: Option<f32>,
     /// Pair edge-width crossings only on triangles that share a vertex (the light-leak fix).
     #[arg(long)]
