@@ -20,11 +20,21 @@ pub fn with_spinner<T>(msg: &str, f: impl FnOnce() -> T) -> T {
     out
 }
 
-/// Loads the scene named by `source`; the error names the scene or file.
+/// Loads the scene named by `source`, printing the loader's warnings to stderr; the error names the scene or
+/// file.
 pub fn load_scene(source: &SceneSource) -> Result<(Scene, f64), String> {
+    let (loaded, seconds) = load_scene_verbose(source)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok((loaded.scene, seconds))
+}
+
+/// Loads the scene named by `source` with its warnings.
+pub fn load_scene_verbose(source: &SceneSource) -> Result<(raylab_scene::Loaded, f64), String> {
     let t0 = Instant::now();
-    let scene = with_spinner("loading scene", || raylab_scene::load(source)).map_err(|e| e.to_string())?;
-    Ok((scene, t0.elapsed().as_secs_f64()))
+    let loaded = with_spinner("loading scene", || raylab_scene::load(source)).map_err(|e| e.to_string())?;
+    Ok((loaded, t0.elapsed().as_secs_f64()))
 }
 
 /// Builds the kd-tree on a pool of `threads` threads.

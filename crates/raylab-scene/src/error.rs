@@ -39,6 +39,14 @@ pub enum SceneError {
         /// What was found instead.
         detail: String,
     },
+    /// The file refers to another file it may not read (absolute, a URL, or outside the model's folder).
+    #[error("{}: {why}", path.display())]
+    Refused {
+        /// The file holding the reference.
+        path: PathBuf,
+        /// Why it was refused.
+        why: String,
+    },
     /// The file's extension is not a supported format.
     #[error("{}: unsupported scene format (supported: .obj)", path.display())]
     Format {

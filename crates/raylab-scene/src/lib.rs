@@ -5,9 +5,23 @@
 pub mod builtin;
 mod error;
 pub mod mesh;
+pub mod normals;
+pub mod obj;
 pub mod obj_positions;
+pub mod paths;
 mod source;
+pub mod texture;
 
 pub use error::SceneError;
 pub use mesh::MeshBuilder;
 pub use source::{SceneSource, load};
+
+/// A loaded scene and what the loader had to work around (missing textures, unreadable material libraries,
+/// dropped triangles), each warning naming the file.
+#[derive(Clone, Debug, Default)]
+pub struct Loaded {
+    /// The scene.
+    pub scene: raylab_core::scene::Scene,
+    /// Warnings, for the terminal or the viewer.
+    pub warnings: Vec<String>,
+}

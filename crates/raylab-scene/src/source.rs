@@ -2,10 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use raylab_core::scene::Scene;
-
-use crate::SceneError;
 use crate::builtin::{self, Detail};
+use crate::{Loaded, SceneError};
 
 /// Where a scene comes from.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -25,15 +23,16 @@ impl SceneSource {
     }
 }
 
-/// Loads a scene. A file without lights or views gets none here; callers supply defaults.
-pub fn load(source: &SceneSource) -> Result<Scene, SceneError> {
+/// Loads a scene with its warnings. A file without lights or views gets none here; callers supply defaults.
+pub fn load(source: &SceneSource) -> Result<Loaded, SceneError> {
     match source {
         SceneSource::Builtin(name) => builtin::build(name, Detail::Full)
+            .map(|scene| Loaded { scene, warnings: Vec::new() })
             .ok_or_else(|| SceneError::UnknownScene { name: name.clone(), valid: builtin::names().join(", ") }),
         SceneSource::File(path) => {
             let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
             match ext.as_deref() {
-                Some("obj") => crate::obj_positions::load(path).map(|(scene, _)| scene),
+                Some("obj") => crate::obj::load(path),
                 _ => Err(SceneError::Format { path: path.clone() }),
             }
         }

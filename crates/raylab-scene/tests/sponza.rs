@@ -90,3 +90,30 @@ fn sponza_render_matches_embree_pixel_for_pixel() {
     assert!(different * 1000 < n, "{different} of {n} pixels differ by more than one level");
     assert!(off_by_one * 20 < n, "{off_by_one} of {n} pixels differ by one level");
 }
+
+/// The full loader (tobj, normals, materials) reads the same triangles as the positions-only path: the same
+/// count and the same primary-ray checksum.
+#[test]
+fn the_full_loader_reads_the_same_sponza() {
+    let Some(path) = sponza_path() else {
+        eprintln!("shared/scenes/sponza/sponza.obj not found beside the checkout; Sponza checks not run");
+        return;
+    };
+    let (positions, _) = raylab_scene::obj_positions::load(&path).unwrap();
+    let full = raylab_scene::obj::load(&path).unwrap().scene;
+    assert_eq!(full.triangle_count() + full.dropped.total(), 66_454);
+    assert_eq!(full.triangle_count(), positions.triangle_count());
+    assert_eq!(full.normals.len(), full.positions.len(), "the file's normals are kept");
+    let camera = Camera::look_at(Vec3::new(-12.5, 2.5, 0.0), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 65.0);
+    let light = Vec3::new(0.0, 11.0, 0.0);
+    let sums: Vec<(usize, f64)> = [&positions, &full]
+        .iter()
+        .map(|s| {
+            let tree = KdTree::build(s, &KdParams::default()).unwrap();
+            let wb = WorkloadBuilder::new(s, &camera, light, 256, 256, &tree);
+            let pass = wb.primary_pass();
+            (pass.hit_count(), pass.sum_t())
+        })
+        .collect();
+    assert_eq!(sums[0], sums[1]);
+}

@@ -27,13 +27,15 @@ pub struct LoadedScene {
     pub build_s: f64,
     /// Size and quality of the tree.
     pub kd_stats: KdStats,
+    /// What the loader worked around (missing textures and the like), each naming the file.
+    pub warnings: Vec<String>,
 }
 
 /// Loads `args`' scene and builds its tree on the calling thread, reporting the stage through `stage`.
 pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Result<LoadedScene, String> {
     let t0 = Instant::now();
     stage("loading scene");
-    let scene = raylab_scene::load(&args.source()).map_err(|e| e.to_string())?;
+    let raylab_scene::Loaded { scene, warnings } = raylab_scene::load(&args.source()).map_err(|e| e.to_string())?;
     let (camera, light) = args.camera_and_light(&scene)?;
     stage("building kd-tree");
     let tree = KdTree::build(&scene, params).map_err(|e| format!("{}: {e}", args.scene))?;
@@ -49,6 +51,7 @@ pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Re
         camera,
         light,
         load_s: t0.elapsed().as_secs_f64(),
+        warnings,
     })
 }
 

@@ -362,6 +362,9 @@ impl Lab {
                         ),
                         false,
                     );
+                    for w in &s.warnings {
+                        self.message(format!("warning: {w}"), true);
+                    }
                     self.fly = FlyCamera::new(s.camera, &s.scene.bounds());
                     self.light = s.light;
                     self.scene = Arc::new(s);
