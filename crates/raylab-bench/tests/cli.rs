@@ -230,3 +230,26 @@ fn trace_reports_the_same_checksum_on_every_backend() {
     }
     assert_eq!(sums[0], sums[1]);
 }
+
+#[test]
+fn info_lists_materials_textures_and_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(6, 3, image::Rgb([200, 10, 10])).save(dir.path().join("red.png")).unwrap();
+    std::fs::write(dir.path().join("m.mtl"), "newmtl brick\nKd 1 1 1\nmap_Kd red.png\nnewmtl lost\nmap_Kd lost.png\n")
+        .unwrap();
+    std::fs::write(
+        dir.path().join("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl brick\nf 1 2 3\nusemtl lost\nf 2 4 3\n",
+    )
+    .unwrap();
+    let o = bench(&["info", "--scene", "m.obj"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for want in ["brick (Diffuse", "red.png (6x3)", "lost.png (8x8)", "warnings         1", "cannot read texture"] {
+        assert!(out.contains(want), "missing '{want}' in:\n{out}");
+    }
+    let o = bench(&["info", "--scene", "m.obj", "--json"], dir.path());
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["textures"][0]["width"], 6);
+    assert_eq!(v["warnings"].as_array().unwrap().len(), 1);
+}

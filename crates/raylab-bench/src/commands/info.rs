@@ -4,9 +4,10 @@ use clap::Args;
 use serde_json::json;
 
 use crate::args::{KdArgs, SceneArgs, in_range};
-use crate::prepare::{build_tree, load_scene};
+use crate::prepare::{build_tree, load_scene_verbose};
 
-/// Prints a scene's triangles, bounds, materials, lights, views and kd-tree statistics.
+/// Prints a scene's triangles, bounds, materials, textures, lights, views, the loader's warnings and kd-tree
+/// statistics.
 #[derive(Args, Debug)]
 pub struct InfoArgs {
     #[command(flatten)]
@@ -23,7 +24,7 @@ pub struct InfoArgs {
 
 /// Runs the command.
 pub fn run(a: &InfoArgs) -> Result<(), String> {
-    let (scene, load_s) = load_scene(&a.scene.source())?;
+    let (raylab_scene::Loaded { scene, warnings }, load_s) = load_scene_verbose(&a.scene.source())?;
     let params = a.kd.params()?;
     let tree = build_tree(&scene, &params, a.threads as usize)?;
     let st = tree.stats();
@@ -35,9 +36,12 @@ pub fn run(a: &InfoArgs) -> Result<(), String> {
             "dropped": { "bad_index": scene.dropped.bad_index, "non_finite": scene.dropped.non_finite,
                          "degenerate": scene.dropped.degenerate },
             "bounds": { "min": b.min.to_array(), "max": b.max.to_array() },
-            "materials": scene.materials.iter().map(|m| &m.name).collect::<Vec<_>>(),
-            "lights": scene.lights.len(),
+            "materials": scene.materials,
+            "textures": scene.textures.iter().map(|t| json!({ "name": t.name, "width": t.width, "height": t.height }))
+                .collect::<Vec<_>>(),
+            "lights": scene.lights,
             "views": scene.views.iter().map(|v| &v.name).collect::<Vec<_>>(),
+            "warnings": warnings,
             "load_seconds": load_s,
             "kd_params": params,
             "kd_build_threads": a.threads,
@@ -50,11 +54,32 @@ pub fn run(a: &InfoArgs) -> Result<(), String> {
     println!("triangles        {} ({} dropped: {:?})", scene.triangle_count(), scene.dropped.total(), scene.dropped);
     println!("vertices         {}", scene.positions.len());
     println!("bounds           {:?} - {:?}, diagonal {:.4}", b.min.to_array(), b.max.to_array(), b.diagonal());
-    let names: Vec<_> = scene.materials.iter().map(|m| format!("{} ({:?})", m.name, m.kind)).collect();
-    println!("materials        {}: {}", names.len(), names.join(", "));
+    println!("materials        {}", scene.materials.len());
+    for m in &scene.materials {
+        let tex = |t: Option<u32>| t.and_then(|i| scene.textures.get(i as usize)).map(|t| t.name.clone());
+        let mut line = format!("  {} ({:?}, base {:?}", m.name, m.kind, m.base_color.to_array());
+        if let Some(t) = tex(m.diffuse_texture) {
+            line += &format!(", diffuse map {t}");
+        }
+        if let Some(t) = tex(m.normal_texture) {
+            line += &format!(", normal map {t}");
+        }
+        println!("{line})");
+    }
+    println!("textures         {}", scene.textures.len());
+    for t in &scene.textures {
+        println!("  {} ({}x{})", t.name, t.width, t.height);
+    }
     println!("lights           {}", scene.lights.len());
+    for l in &scene.lights {
+        println!("  at {:?}, colour {:?}, radius {}", l.position.to_array(), l.color.to_array(), l.radius);
+    }
     let views: Vec<_> = scene.views.iter().map(|v| v.name.as_str()).collect();
     println!("views            {}", if views.is_empty() { "none".into() } else { views.join(", ") });
+    println!("warnings         {}", warnings.len());
+    for w in &warnings {
+        println!("  {w}");
+    }
     println!("load             {load_s:.3} s");
     println!(
         "kd params        c_trav {} c_isect {} empty_bonus {} max_depth {}",

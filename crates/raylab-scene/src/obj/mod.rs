@@ -50,7 +50,7 @@ pub fn load(path: &Path) -> Result<Loaded, SceneError> {
         match std::fs::read(&file) {
             Ok(b) => {
                 mtl_files.borrow_mut().push(file.clone());
-                tobj::load_mtl_buf(&mut Cursor::new(b)).inspect_err(|e| {
+                tobj::load_mtl_buf(&mut Cursor::new(mtl::normalise(&b))).inspect_err(|e| {
                     mtl_warnings
                         .borrow_mut()
                         .push(format!("{}: {e}; its materials are replaced by a grey one", file.display()));

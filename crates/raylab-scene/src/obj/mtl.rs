@@ -76,3 +76,28 @@ pub fn convert(
         absorption: Vec3::ZERO,
     }
 }
+
+/// MTL text as tobj can take it: a colour statement (`Ka`, `Kd`, `Ks`, `Ke`) with one or two numbers gets the
+/// missing ones from the first, as the MTL specification says, and one with none is dropped (tobj 4.0.5
+/// panics on fewer than three).
+pub fn normalise(bytes: &[u8]) -> Vec<u8> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut out = String::with_capacity(text.len() + 16);
+    for line in text.split_inclusive('\n') {
+        let mut words = line.split_whitespace();
+        let tag = words.next();
+        let values: Vec<&str> = words.collect();
+        let colour = matches!(tag, Some("Ka" | "Kd" | "Ks" | "Ke"));
+        if colour && values.is_empty() {
+            continue;
+        }
+        if colour && values.len() < 3 {
+            let r = values[0];
+            let g = values.get(1).copied().unwrap_or(r);
+            out += &format!("{} {r} {g} {r}\n", tag.unwrap_or_default());
+        } else {
+            out += line;
+        }
+    }
+    out.into_bytes()
+}
