@@ -39,6 +39,14 @@ pub enum SceneError {
         /// What was found instead.
         detail: String,
     },
+    /// The file is not valid for its (non-line-based) format; the message says where.
+    #[error("{}: {message}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// The file refers to another file it may not read (absolute, a URL, or outside the model's folder).
     #[error("{}: {why}", path.display())]
     Refused {
@@ -48,7 +56,7 @@ pub enum SceneError {
         why: String,
     },
     /// The file's extension is not a supported format.
-    #[error("{}: unsupported scene format (supported: .obj)", path.display())]
+    #[error("{}: unsupported scene format (supported: .obj, .gltf, .glb)", path.display())]
     Format {
         /// The file.
         path: PathBuf,

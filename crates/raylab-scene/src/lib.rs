@@ -4,6 +4,7 @@
 
 pub mod builtin;
 mod error;
+pub mod gltf_model;
 pub mod mesh;
 pub mod normals;
 pub mod obj;

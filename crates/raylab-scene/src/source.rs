@@ -33,6 +33,7 @@ pub fn load(source: &SceneSource) -> Result<Loaded, SceneError> {
             let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
             match ext.as_deref() {
                 Some("obj") => crate::obj::load(path),
+                Some("gltf" | "glb") => crate::gltf_model::load(path),
                 _ => Err(SceneError::Format { path: path.clone() }),
             }
         }
