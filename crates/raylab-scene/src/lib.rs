@@ -10,6 +10,7 @@ pub mod normals;
 pub mod obj;
 pub mod obj_positions;
 pub mod paths;
+pub mod sidecar;
 mod source;
 pub mod texture;
 

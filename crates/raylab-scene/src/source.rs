@@ -23,7 +23,8 @@ impl SceneSource {
     }
 }
 
-/// Loads a scene with its warnings. A file without lights or views gets none here; callers supply defaults.
+/// Loads a scene with its warnings, adding the views and lights of a sidecar file ([`crate::sidecar`]). A file
+/// without lights or views gets none here; callers supply defaults.
 pub fn load(source: &SceneSource) -> Result<Loaded, SceneError> {
     match source {
         SceneSource::Builtin(name) => builtin::build(name, Detail::Full)
@@ -31,11 +32,13 @@ pub fn load(source: &SceneSource) -> Result<Loaded, SceneError> {
             .ok_or_else(|| SceneError::UnknownScene { name: name.clone(), valid: builtin::names().join(", ") }),
         SceneSource::File(path) => {
             let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-            match ext.as_deref() {
+            let mut loaded = match ext.as_deref() {
                 Some("obj") => crate::obj::load(path),
                 Some("gltf" | "glb") => crate::gltf_model::load(path),
                 _ => Err(SceneError::Format { path: path.clone() }),
-            }
+            }?;
+            crate::sidecar::apply(path, &mut loaded.scene, &mut loaded.warnings);
+            Ok(loaded)
         }
     }
 }

@@ -157,3 +157,20 @@ fn bad_files_give_specific_errors() {
     let e = obj::load(&dir.path().join("binary.obj")).unwrap_err().to_string();
     assert!(e.contains("binary.obj:1") && e.contains("UTF-8"), "{e}");
 }
+
+/// A sidecar beside the model names views (picked with `--view` and listed in the viewer) and lights.
+#[test]
+fn a_sidecar_file_adds_named_views_and_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "hall.obj", &format!("{QUAD}f 1 2 3 4\n"));
+    write(
+        dir.path(),
+        "hall.views.json",
+        r#"{ "views": [ { "name": "door", "eye": [0.5, 0.5, 3], "target": [0.5, 0.5, 0], "fov": 40 } ], "lights": [ { "position": [0, 0, 2], "radius": 0.25 } ] }"#,
+    );
+    let source = raylab_scene::SceneSource::parse(model.to_str().unwrap());
+    let Loaded { scene, warnings } = raylab_scene::load(&source).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(scene.view("door").unwrap().camera.vfov_deg, 40.0);
+    assert_eq!(scene.lights[0].radius, 0.25);
+}

@@ -91,7 +91,9 @@ pub fn timestamped(stem: &str) -> PathBuf {
 
 /// Scene files the Open dialog lists.
 fn is_scene_file(p: &std::path::Path) -> bool {
-    p.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| ["obj", "gltf", "glb"].iter().any(|x| e.eq_ignore_ascii_case(x)))
 }
 
 impl Lab {

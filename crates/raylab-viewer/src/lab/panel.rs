@@ -51,13 +51,17 @@ fn scene_section(lab: &mut Lab, ui: &mut egui::Ui) {
             if ui.button("Open...").clicked() {
                 lab.open_dialog();
             }
-            ui.add(egui::TextEdit::singleline(&mut lab.open_path).hint_text("path/to/scene.obj").desired_width(170.0));
+            ui.add(
+                egui::TextEdit::singleline(&mut lab.open_path)
+                    .hint_text("path/to/scene.obj, .gltf or .glb")
+                    .desired_width(170.0),
+            );
             if ui.button("Load").clicked() {
                 let p = lab.open_path.clone();
                 lab.open(&p);
             }
         });
-        ui.small("or drop an .obj file on the window");
+        ui.small("or drop an .obj, .gltf or .glb file on the window");
         let s = &lab.scene;
         ui.label(format!(
             "{} triangles, {} kd nodes (depth {}), built in {:.2} s",
