@@ -5,6 +5,7 @@
 use std::time::Instant;
 
 use raylab_core::kdtree::{KdParams, KdTree};
+use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
 use raylab_core::render::{Frame, RenderSettings, render};
@@ -45,8 +46,12 @@ pub fn render_still(
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     let t0 = Instant::now();
     let reference = (options.method == Method::Reference).then(|| BruteForce::new(&loaded));
+    let mbvh = (options.method == Method::Mbvh).then(|| pool.install(|| Mbvh::build(&loaded)));
     let frame = {
-        let tracer = Tracer::new(&tree, reference.as_ref(), options);
+        let mut tracer = Tracer::new(&tree, reference.as_ref(), options);
+        if let Some(m) = &mbvh {
+            tracer = tracer.with_mbvh(m);
+        }
         pool.install(|| render(&loaded, &tracer, &camera, light, settings))
     };
     let render_s = t0.elapsed().as_secs_f64();

@@ -53,6 +53,8 @@ pub struct TraceReport {
     pub leaves_per_ray: f64,
     /// Triangle tests per ray.
     pub isects_per_ray: f64,
+    /// SIMD four-box tests per ray (MBVH).
+    pub box_tests_per_ray: f64,
     /// The thesis's N: nodes per 2x2 packet (per ray for single-ray methods).
     pub nodes_per_packet: f64,
     /// The thesis's I: intersection tests per 2x2 packet (per ray for single-ray methods).
@@ -158,6 +160,7 @@ pub fn measure(
         nodes_per_ray: stats.nodes_per_ray(),
         leaves_per_ray: stats.leaves_per_ray(),
         isects_per_ray: stats.isects_per_ray(),
+        box_tests_per_ray: stats.box_tests as f64 / stats.rays.max(1) as f64,
         nodes_per_packet: stats.nodes_per_packet(),
         isects_per_packet: stats.isects_per_packet(),
         culled_percent: culled_percent(&stats),

@@ -10,6 +10,7 @@
 
 pub mod aabb;
 pub mod kdtree;
+pub mod mbvh;
 pub mod method;
 pub mod packet;
 pub mod ray;

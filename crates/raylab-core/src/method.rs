@@ -6,6 +6,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use crate::kdtree::KdTree;
+use crate::mbvh::Mbvh;
 use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
 use crate::stats::TraversalStats;
@@ -27,14 +28,24 @@ pub enum Method {
     Cone,
     /// MFT over four cones per tile (thesis 4.1.9, Table 4.5).
     MftCone,
+    /// One ray at a time through the 4-wide MBVH, four boxes per SIMD test (MBVH RS paper, section 3.1).
+    Mbvh,
     /// Every ray against every triangle; for testing only.
     Reference,
 }
 
 impl Method {
     /// All methods, in the order menus list them.
-    pub const ALL: [Method; 7] =
-        [Method::Mono, Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone, Method::Reference];
+    pub const ALL: [Method; 8] = [
+        Method::Mono,
+        Method::Packet,
+        Method::Frustum,
+        Method::Mft,
+        Method::Cone,
+        Method::MftCone,
+        Method::Mbvh,
+        Method::Reference,
+    ];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -45,6 +56,7 @@ impl Method {
             Method::Mft => "mft",
             Method::Cone => "cone",
             Method::MftCone => "mft-cone",
+            Method::Mbvh => "mbvh",
             Method::Reference => "reference",
         }
     }
@@ -90,6 +102,15 @@ impl Intersector for KdTree {
     }
     fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
         KdTree::occluded(self, ray, stats)
+    }
+}
+
+impl Intersector for Mbvh {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        Mbvh::intersect(self, ray, stats)
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        Mbvh::occluded(self, ray, stats)
     }
 }
 

@@ -29,6 +29,9 @@ pub struct TraversalStats {
     pub packets_culled: u64,
     /// Packet visits to non-empty leaves that went on to triangle tests (culled ones excluded).
     pub packets_tested: u64,
+    /// SIMD tests of a ray against a node's four boxes (MBVH traversal; MBVH RS paper, Figure 4).
+    #[serde(default)]
+    pub box_tests: u64,
     /// Shadow rays that first tested a cached blocker (the shadow cache).
     #[serde(default)]
     pub cache_lookups: u64,
@@ -46,6 +49,7 @@ impl AddAssign for TraversalStats {
         self.packets += o.packets;
         self.packets_culled += o.packets_culled;
         self.packets_tested += o.packets_tested;
+        self.box_tests += o.box_tests;
         self.cache_lookups += o.cache_lookups;
         self.cache_hits += o.cache_hits;
     }
@@ -101,6 +105,7 @@ mod tests {
             packets: 2,
             packets_culled: 0,
             packets_tested: 0,
+            box_tests: 0,
             cache_lookups: 1,
             cache_hits: 1,
         };
@@ -112,6 +117,7 @@ mod tests {
             packets: 2,
             packets_culled: 1,
             packets_tested: 3,
+            box_tests: 0,
             cache_lookups: 3,
             cache_hits: 0,
         };

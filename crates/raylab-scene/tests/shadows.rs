@@ -4,6 +4,7 @@
 
 use glam::Vec3;
 use raylab_core::kdtree::{KdParams, KdTree};
+use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
@@ -15,7 +16,9 @@ use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::builtin::{self, Detail};
 use raylab_scene::mesh::{Jitter, MeshBuilder};
 
-const COHERENT: [Method; 5] = [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone];
+/// The methods compared with mono (the MBVH's single rays included).
+const COHERENT: [Method; 6] =
+    [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone, Method::Mbvh];
 
 fn techniques(light: &PointLight) -> Vec<Shadows> {
     let r = light.radius.max(0.1);
@@ -46,6 +49,7 @@ fn every_technique_gives_the_same_pixels_with_every_method() {
         let scene = builtin::build(name, Detail::Test).unwrap();
         let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
         let bf = BruteForce::new(&scene);
+        let mbvh = Mbvh::build(&scene);
         let cam = scene.default_view().unwrap().camera;
         let light = scene.lights[0];
         for shadows in techniques(&light) {
@@ -55,7 +59,8 @@ fn every_technique_gives_the_same_pixels_with_every_method() {
             assert!(lit > want.len() / 4, "{name} {shadows}: the frame is mostly dark ({lit} lit pixels)");
             for method in COHERENT {
                 for tile in [4, 16] {
-                    let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
+                    let tracer =
+                        Tracer::new(&tree, None, TraceOptions { method, ..Default::default() }).with_mbvh(&mbvh);
                     let got = frame(&scene, &tracer, &cam, light, shadows, tile);
                     let diff = got.iter().zip(&want).filter(|(a, b)| a != b).count();
                     assert_eq!(diff, 0, "{name}, {shadows}, {method} tile {tile}: {diff} pixels differ from mono");

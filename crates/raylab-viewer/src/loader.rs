@@ -1,4 +1,4 @@
-//! Loading a scene and building its kd-tree on a background thread, so the window keeps drawing (and the
+//! Loading a scene and building its kd-tree and MBVH on a background thread, so the window keeps drawing (and the
 //! current scene stays usable) while a large model loads; a failure leaves the current scene in place.
 
 use std::sync::mpsc::{self, Receiver, TryRecvError};
@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use raylab_bench::args::SceneArgs;
 use raylab_core::kdtree::{KdParams, KdStats, KdTree};
+use raylab_core::mbvh::Mbvh;
 use raylab_core::scene::{Camera, PointLight, Scene};
 
 /// A scene ready to trace: the triangles, their kd-tree, and the view and light it opened with.
@@ -17,6 +18,8 @@ pub struct LoadedScene {
     pub scene: Scene,
     /// Its kd-tree.
     pub tree: KdTree,
+    /// Its 4-wide BVH, for the mbvh method.
+    pub mbvh: Mbvh,
     /// The camera the scene opened with (the flags, the scene's default view, or a view of the whole scene).
     pub camera: Camera,
     /// The benchmark light.
@@ -39,6 +42,8 @@ pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Re
     let (camera, light) = args.camera_and_light(&scene)?;
     stage("building kd-tree");
     let tree = KdTree::build(&scene, params).map_err(|e| format!("{}: {e}", args.scene))?;
+    stage("building MBVH");
+    let mbvh = Mbvh::build(&scene);
     let name = std::path::Path::new(&args.scene)
         .file_name()
         .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
@@ -48,6 +53,7 @@ pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Re
         kd_stats: tree.stats(),
         scene,
         tree,
+        mbvh,
         camera,
         light,
         load_s: t0.elapsed().as_secs_f64(),

@@ -213,7 +213,8 @@ fn send(tx: &Sender<WorkerEvent>, wake: &dyn Fn(), ev: WorkerEvent) {
 pub fn trace_frame(job: &Job, method: Method) -> Rendered {
     let s = &job.scene;
     let settings = job.settings.render_settings(job.size.0, job.size.1);
-    let tracer = Tracer::new(&s.tree, None, raylab_core::trace::TraceOptions { method, ..job.settings.trace });
+    let tracer = Tracer::new(&s.tree, None, raylab_core::trace::TraceOptions { method, ..job.settings.trace })
+        .with_mbvh(&s.mbvh);
     let t0 = Instant::now();
     let frame = render(&s.scene, &tracer, &job.camera, job.light, &settings);
     Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings }

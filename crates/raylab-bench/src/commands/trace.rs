@@ -1,6 +1,8 @@
 //! `raylab-bench trace`: throughput of one method on the harness's rays.
 
 use clap::Args;
+use raylab_core::mbvh::Mbvh;
+use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
 use raylab_core::trace::Tracer;
 use raylab_core::workload::{RayKind, WorkloadBuilder};
@@ -62,7 +64,15 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     });
     let workload = builder.build(a.kind);
     let options = a.m.options();
-    let tracer = Tracer::new(&tree, Some(&reference), options);
+    let mbvh = (options.method == Method::Mbvh).then(|| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string());
+        pool.map(|p| with_spinner("building MBVH", || p.install(|| Mbvh::build(&scene))))
+    });
+    let mbvh = mbvh.transpose()?;
+    let mut tracer = Tracer::new(&tree, Some(&reference), options);
+    if let Some(m) = &mbvh {
+        tracer = tracer.with_mbvh(m);
+    }
     let (report, results) =
         measure(&tracer, &workload, a.m.tile as u32, a.threads as usize, a.warmup as usize, a.reps as usize)?;
     let checked = with_spinner("validating against brute force", || {
@@ -83,6 +93,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
             "cull": options.cull,
             "backend": options.backend.name(),
             "kd_build_seconds": tree.build_time().as_secs_f64(),
+            "mbvh": mbvh.as_ref().map(Mbvh::stats),
             "validated_rays": checked,
             "result": report,
         });
@@ -92,6 +103,13 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     println!("environment      {}", env.line());
     println!("scene            {} ({} triangles), {}x{}", a.scene.scene, scene.triangle_count(), w, h);
     println!("kd-tree          built in {:.3} s on {} thread(s)", tree.build_time().as_secs_f64(), a.threads);
+    if let Some(m) = &mbvh {
+        let st = m.stats();
+        println!(
+            "MBVH             built in {:.3} s on {} thread(s): {} nodes ({:.0}% of lanes used), {} leaves, depth {}",
+            st.build_seconds, a.threads, st.nodes, st.lane_fill_percent, st.leaves, st.depth
+        );
+    }
     println!("validated        {checked} rays against brute force");
     let what = if a.kind.is_occlusion() { "occluded" } else { "hits" };
     println!(
@@ -112,8 +130,8 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         report.mrays_median, report.mrays_min, report.mrays_max, a.reps
     );
     println!(
-        "per ray          {:.2} nodes, {:.2} leaves, {:.2} triangle tests",
-        report.nodes_per_ray, report.leaves_per_ray, report.isects_per_ray
+        "per ray          {:.2} nodes, {:.2} leaves, {:.2} triangle tests, {:.2} 4-box tests",
+        report.nodes_per_ray, report.leaves_per_ray, report.isects_per_ray, report.box_tests_per_ray
     );
     println!(
         "per packet       N {:.2} nodes, I {:.2} tests, {:.1}% of packet/leaf visits culled",

@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
+use crate::mbvh::Mbvh;
 use crate::method::Method;
 use crate::packet::{Cone, Cone4};
 use crate::packet::{Frustum, PacketTile};
@@ -59,6 +60,7 @@ impl Default for TraceOptions {
 pub struct Tracer<'a> {
     tree: &'a KdTree,
     reference: Option<&'a BruteForce>,
+    mbvh: Option<&'a Mbvh>,
     /// The options.
     pub options: TraceOptions,
 }
@@ -70,19 +72,34 @@ const TOWARD_TOLERANCE: f32 = 1e-3;
 impl<'a> Tracer<'a> {
     /// A tracer over `tree`; `reference` is needed only for [`Method::Reference`].
     pub fn new(tree: &'a KdTree, reference: Option<&'a BruteForce>, options: TraceOptions) -> Self {
-        Self { tree, reference, options }
+        Self { tree, reference, mbvh: None, options }
+    }
+
+    /// The same tracer with an MBVH over the same scene, needed for [`Method::Mbvh`].
+    pub fn with_mbvh(self, mbvh: &'a Mbvh) -> Self {
+        Self { mbvh: Some(mbvh), ..self }
+    }
+
+    fn mbvh(&self) -> &'a Mbvh {
+        self.mbvh.expect("the mbvh method needs an Mbvh (Tracer::with_mbvh)")
     }
 
     /// The same tracer with another traversal method (the brute-force reference stays the reference).
     pub fn with_method(&self, method: Method) -> Tracer<'a> {
         let method = if self.options.method == Method::Reference { Method::Reference } else { method };
-        Tracer { tree: self.tree, reference: self.reference, options: TraceOptions { method, ..self.options } }
+        Tracer {
+            tree: self.tree,
+            reference: self.reference,
+            mbvh: self.mbvh,
+            options: TraceOptions { method, ..self.options },
+        }
     }
 
     /// The first blocker found along a single ray (for the shadow cache).
     pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         match self.options.method {
             Method::Reference => self.reference().occluder(ray, stats),
+            Method::Mbvh => self.mbvh().occluder(ray, stats),
             _ => self.tree.occluder(ray, stats),
         }
     }
@@ -96,7 +113,8 @@ impl<'a> Tracer<'a> {
     }
 
     /// The edge-width occlusion of a single shadow ray (thesis Listing 5.1). Edge-width rays are traced one
-    /// at a time by every method: the kd-tree kernel, or the brute-force reference for [`Method::Reference`].
+    /// at a time by every method: the kd-tree kernel (also for [`Method::Mbvh`]: a BVH does not visit leaves in
+    /// distance order, which the pairing relies on), or the brute-force reference for [`Method::Reference`].
     pub fn edge_width(&self, ray: &Ray, state: &mut EdgeWidth, stats: &mut TraversalStats) -> f32 {
         match self.options.method {
             Method::Reference => self.reference().edge_width(ray, state, stats),
@@ -130,6 +148,12 @@ impl<'a> Tracer<'a> {
                     *o = r.and_then(|r| bf.intersect(&r, stats));
                 }
             }
+            Method::Mbvh => {
+                let m = self.mbvh();
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = r.and_then(|r| m.intersect(&r, stats));
+                }
+            }
             _ => match self.options.backend {
                 #[cfg(target_arch = "x86_64")]
                 Backend::Sse => self.intersect_simd::<raylab_simd::sse::F32x4>(rays, width, height, out, stats),
@@ -159,6 +183,12 @@ impl<'a> Tracer<'a> {
                 let bf = self.reference();
                 for (o, r) in out.iter_mut().zip(rays) {
                     *o = r.is_some_and(|r| bf.occluded(&r, stats));
+                }
+            }
+            Method::Mbvh => {
+                let m = self.mbvh();
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = r.is_some_and(|r| m.occluded(&r, stats));
                 }
             }
             _ => match self.options.backend {

@@ -87,7 +87,11 @@ pub fn check_accessor(
         return Err(format!("{what}: stride {stride} is smaller than an element ({elem} bytes)"));
     }
     let count = accessor.count();
-    if count > 0 {
+    // glTF requires at least one element (and gltf 1.4.1 computes `count - 1` unchecked).
+    if count == 0 {
+        return Err(format!("{what} has no elements"));
+    }
+    {
         let end = (count - 1)
             .checked_mul(stride)
             .and_then(|x| x.checked_add(accessor.offset()))

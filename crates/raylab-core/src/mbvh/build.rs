@@ -1,0 +1,228 @@
+//! Building the 4-wide MBVH: a binary BVH by binned SAH over triangle centroids (16 bins on the widest
+//! centroid axis, the halves built in parallel with rayon), then collapsed top-down into 4-wide nodes by
+//! repeatedly opening the child with the largest surface area (Wald et al. 2008, as the MBVH RS paper builds).
+
+use glam::Vec3;
+
+use super::node::{EMPTY, MbvhNode};
+use crate::aabb::Aabb;
+
+/// Triangles per leaf above which a node is always split.
+pub const MAX_LEAF: usize = 8;
+/// SAH bins per node.
+const BINS: usize = 16;
+/// Cost of a box test relative to a triangle test in the SAH.
+const C_TRAV: f32 = 1.0;
+/// Binary depth from which lists are halved instead of split by SAH, so that the tree (and the traversal
+/// stack) stays shallow whatever the input: at most 48 SAH levels, then log2 of the rest.
+const MAX_SAH_DEPTH: u32 = 48;
+/// Nodes with at least this many triangles build their halves in parallel.
+const PARALLEL_MIN: usize = 4096;
+
+/// A binary build node.
+enum Bin {
+    Leaf { bounds: Aabb, first: u32, count: u32 },
+    Inner { bounds: Aabb, children: Box<[Bin; 2]> },
+}
+
+impl Bin {
+    fn bounds(&self) -> Aabb {
+        match self {
+            Bin::Leaf { bounds, .. } | Bin::Inner { bounds, .. } => *bounds,
+        }
+    }
+}
+
+/// The finished arrays: 4-wide nodes (the root first) and the triangle ids the leaves index.
+pub struct Built {
+    pub nodes: Vec<MbvhNode>,
+    pub tri_ids: Vec<u32>,
+    /// Nodes of the binary BVH before collapsing (for statistics).
+    pub binary_nodes: usize,
+}
+
+/// Builds over triangles given by their bounds and centroids.
+pub fn build(boxes: &[Aabb], centroids: &[Vec3]) -> Built {
+    let mut ids: Vec<u32> = (0..boxes.len() as u32).collect();
+    let mut count = 0usize;
+    let root = if ids.is_empty() {
+        Bin::Leaf { bounds: Aabb::EMPTY, first: 0, count: 0 }
+    } else {
+        split(boxes, centroids, &mut ids, 0, 0, &mut count)
+    };
+    let mut nodes = vec![MbvhNode::empty()];
+    match &root {
+        Bin::Leaf { bounds, first, count } => {
+            if *count > 0 {
+                put(&mut nodes[0], 0, bounds, *first, *count);
+            }
+        }
+        Bin::Inner { .. } => collapse(&root, 0, &mut nodes),
+    }
+    Built { nodes, tri_ids: ids, binary_nodes: count }
+}
+
+/// Relative padding of stored boxes: the slab test's rounding (a few ulps of the coordinates, amplified for
+/// rays leaving a surface, whose hits lie at tiny distances) must never cull a box the ray touches.
+const BOX_PAD: f32 = 16.0 * f32::EPSILON;
+
+/// Writes a child's padded box and reference into lane `k` of `node`.
+fn put(node: &mut MbvhNode, k: usize, b: &Aabb, first: u32, count: u32) {
+    for a in 0..3 {
+        let pad = BOX_PAD * b.min[a].abs().max(b.max[a].abs()) + f32::MIN_POSITIVE;
+        node.min[a][k] = b.min[a] - pad;
+        node.max[a][k] = b.max[a] + pad;
+    }
+    node.child[k] = first;
+    node.count[k] = count;
+    node.used |= 1 << k;
+}
+
+/// Fills node `at` from binary inner node `n`: up to four grandchildren, opening the largest inner child
+/// first; inner lanes recurse into new nodes.
+fn collapse(n: &Bin, at: usize, nodes: &mut Vec<MbvhNode>) {
+    let Bin::Inner { children, .. } = n else { return };
+    let mut lanes: Vec<&Bin> = vec![&children[0], &children[1]];
+    while lanes.len() < 4 {
+        let widest = lanes
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| matches!(b, Bin::Inner { .. }))
+            .max_by(|a, b| a.1.bounds().surface_area().total_cmp(&b.1.bounds().surface_area()))
+            .map(|(i, _)| i);
+        let Some(i) = widest else { break };
+        let Bin::Inner { children, .. } = lanes.swap_remove(i) else { unreachable!() };
+        lanes.push(&children[0]);
+        lanes.push(&children[1]);
+    }
+    for (k, lane) in lanes.into_iter().enumerate() {
+        match lane {
+            Bin::Leaf { bounds, first, count } => put(&mut nodes[at], k, bounds, *first, *count),
+            Bin::Inner { bounds, .. } => {
+                let index = nodes.len();
+                nodes.push(MbvhNode::empty());
+                put(&mut nodes[at], k, bounds, index as u32, 0);
+                collapse(lane, index, nodes);
+            }
+        }
+    }
+    debug_assert!(nodes[at].child.iter().any(|&c| c != EMPTY));
+}
+
+/// Builds the binary subtree over `ids` (which start at `offset` in the final id array), partitioning `ids`
+/// in place.
+fn split(boxes: &[Aabb], centroids: &[Vec3], ids: &mut [u32], offset: u32, depth: u32, nodes: &mut usize) -> Bin {
+    *nodes += 1;
+    let bounds = ids.iter().fold(Aabb::EMPTY, |b, &i| b.union(boxes[i as usize]));
+    let n = ids.len();
+    let leaf = Bin::Leaf { bounds, first: offset, count: n as u32 };
+    if n <= 2 {
+        return leaf;
+    }
+    let cb = ids.iter().fold(Aabb::EMPTY, |b, &i| b.grow(centroids[i as usize]));
+    let extent = cb.extent();
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let (lo, width) = (cb.min[axis], extent[axis]);
+    // Deep in the tree (lopsided SAH splits on pathological input), halve the list to bound the depth.
+    let mid = if depth >= MAX_SAH_DEPTH {
+        Some(n / 2)
+    } else if width > 0.0 && width.is_finite() {
+        best_split(boxes, centroids, ids, axis, lo, width, bounds).and_then(|(bin, cost)| {
+            // Split when it beats a leaf, and always when the leaf would be too big.
+            (cost < n as f32 || n > MAX_LEAF).then(|| {
+                let scale = BINS as f32 / width;
+                partition(ids, |i| bin_of(centroids[i as usize][axis], lo, scale) <= bin)
+            })
+        })
+    } else {
+        None
+    };
+    let mid = match mid {
+        Some(m) if m > 0 && m < n => m,
+        _ if n > MAX_LEAF => n / 2, // all centroids in one bin: split the list in half
+        _ => return leaf,
+    };
+    let (left, right) = ids.split_at_mut(mid);
+    let (mut nl, mut nr) = (0, 0);
+    let (l, r) = if n >= PARALLEL_MIN {
+        rayon::join(
+            || split(boxes, centroids, left, offset, depth + 1, &mut nl),
+            || split(boxes, centroids, right, offset + mid as u32, depth + 1, &mut nr),
+        )
+    } else {
+        (
+            split(boxes, centroids, left, offset, depth + 1, &mut nl),
+            split(boxes, centroids, right, offset + mid as u32, depth + 1, &mut nr),
+        )
+    };
+    *nodes += nl + nr;
+    Bin::Inner { bounds, children: Box::new([l, r]) }
+}
+
+#[inline]
+fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
+    (((c - lo) * scale) as usize).min(BINS - 1)
+}
+
+/// The bin after which to split (left = bins `0..=bin`) and its SAH cost, in units of triangle tests.
+fn best_split(
+    boxes: &[Aabb],
+    centroids: &[Vec3],
+    ids: &[u32],
+    axis: usize,
+    lo: f32,
+    width: f32,
+    bounds: Aabb,
+) -> Option<(usize, f32)> {
+    let scale = BINS as f32 / width;
+    let mut bin_box = [Aabb::EMPTY; BINS];
+    let mut bin_n = [0u32; BINS];
+    for &i in ids {
+        let b = bin_of(centroids[i as usize][axis], lo, scale);
+        bin_box[b] = bin_box[b].union(boxes[i as usize]);
+        bin_n[b] += 1;
+    }
+    // Sweep from the right to get the right-side areas, then from the left.
+    let mut right_area = [0.0f32; BINS];
+    let mut right_n = [0u32; BINS];
+    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+    for b in (1..BINS).rev() {
+        acc = acc.union(bin_box[b]);
+        cnt += bin_n[b];
+        right_area[b] = acc.surface_area();
+        right_n[b] = cnt;
+    }
+    let area = bounds.surface_area().max(f32::MIN_POSITIVE);
+    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+    let mut best: Option<(usize, f32)> = None;
+    for b in 0..BINS - 1 {
+        acc = acc.union(bin_box[b]);
+        cnt += bin_n[b];
+        if cnt == 0 || right_n[b + 1] == 0 {
+            continue;
+        }
+        let cost = C_TRAV + (acc.surface_area() * cnt as f32 + right_area[b + 1] * right_n[b + 1] as f32) / area;
+        if best.is_none_or(|(_, c)| cost < c) {
+            best = Some((b, cost));
+        }
+    }
+    best
+}
+
+/// Moves the ids for which `left` holds to the front; returns how many there are.
+fn partition(ids: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
+    let mut i = 0;
+    for j in 0..ids.len() {
+        if left(ids[j]) {
+            ids.swap(i, j);
+            i += 1;
+        }
+    }
+    i
+}

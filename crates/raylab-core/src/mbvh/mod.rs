@@ -1,0 +1,130 @@
+//! The 4-wide bounding volume hierarchy ("MBVH") of the MBVH RS paper (Tsakok 2009, seed 001): build, node
+//! layout and single-ray traversal.
+
+mod build;
+mod node;
+mod single;
+
+pub use node::{EMPTY, MbvhNode};
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use raylab_simd::Backend;
+use serde::Serialize;
+
+use crate::aabb::Aabb;
+use crate::scene::Scene;
+use crate::triangle::TriangleSoup;
+
+/// A 4-wide BVH over a scene's triangles.
+#[derive(Clone, Debug)]
+pub struct Mbvh {
+    nodes: Vec<MbvhNode>,
+    tri_ids: Vec<u32>,
+    tris: TriangleSoup,
+    bounds: Aabb,
+    build_time: Duration,
+    binary_nodes: usize,
+    /// SIMD backend of the box tests.
+    pub backend: Backend,
+}
+
+/// Size and shape of an MBVH.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct MbvhStats {
+    /// Seconds the build took.
+    pub build_seconds: f64,
+    /// 4-wide nodes.
+    pub nodes: usize,
+    /// Nodes of the binary BVH it was collapsed from.
+    pub binary_nodes: usize,
+    /// Leaves (lanes holding triangles).
+    pub leaves: usize,
+    /// Used lanes over all lanes, in percent.
+    pub lane_fill_percent: f64,
+    /// Mean triangles per leaf.
+    pub avg_tris_per_leaf: f64,
+    /// Deepest level of 4-wide nodes (the root is 1).
+    pub depth: usize,
+    /// Bytes of nodes and triangle ids.
+    pub bytes: usize,
+}
+
+impl Mbvh {
+    /// Builds the MBVH of `scene` on the current rayon pool.
+    pub fn build(scene: &Scene) -> Self {
+        let start = Instant::now();
+        let tris = TriangleSoup::from_scene(scene);
+        let boxes: Vec<Aabb> = tris.as_slice().iter().map(|t| Aabb::from_points(*t)).collect();
+        let centroids: Vec<Vec3> = boxes.iter().map(Aabb::center).collect();
+        let built = build::build(&boxes, &centroids);
+        Self {
+            nodes: built.nodes,
+            tri_ids: built.tri_ids,
+            bounds: scene.bounds(),
+            tris,
+            build_time: start.elapsed(),
+            binary_nodes: built.binary_nodes,
+            backend: Backend::detect(),
+        }
+    }
+
+    /// The nodes, the root first.
+    pub fn nodes(&self) -> &[MbvhNode] {
+        &self.nodes
+    }
+
+    /// Triangle ids indexed by leaves.
+    pub fn tri_ids(&self) -> &[u32] {
+        &self.tri_ids
+    }
+
+    /// The triangles.
+    pub fn triangles(&self) -> &TriangleSoup {
+        &self.tris
+    }
+
+    /// Bounds of the scene.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// How long the build took.
+    pub fn build_time(&self) -> Duration {
+        self.build_time
+    }
+
+    /// Node statistics.
+    pub fn stats(&self) -> MbvhStats {
+        let (mut leaves, mut used, mut tris) = (0usize, 0usize, 0usize);
+        for n in &self.nodes {
+            for k in 0..4 {
+                if !n.is_empty(k) {
+                    used += 1;
+                }
+                if n.is_leaf(k) {
+                    leaves += 1;
+                    tris += n.count[k] as usize;
+                }
+            }
+        }
+        let mut depth = 0;
+        let mut stack = vec![(0usize, 1usize)];
+        while let Some((i, d)) = stack.pop() {
+            depth = depth.max(d);
+            let n = &self.nodes[i];
+            stack.extend((0..4).filter(|&k| !n.is_empty(k) && !n.is_leaf(k)).map(|k| (n.child[k] as usize, d + 1)));
+        }
+        MbvhStats {
+            build_seconds: self.build_time.as_secs_f64(),
+            nodes: self.nodes.len(),
+            binary_nodes: self.binary_nodes,
+            leaves,
+            lane_fill_percent: 100.0 * used as f64 / (4 * self.nodes.len()).max(1) as f64,
+            avg_tris_per_leaf: tris as f64 / leaves.max(1) as f64,
+            depth,
+            bytes: self.nodes.len() * std::mem::size_of::<MbvhNode>() + self.tri_ids.len() * 4,
+        }
+    }
+}
