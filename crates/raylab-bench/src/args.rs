@@ -198,10 +198,11 @@ impl KdArgs {
 /// Traversal-method flags shared by `render` and `trace`.
 #[derive(Args, Clone, Debug)]
 pub struct MethodArgs {
-    /// Traversal method: mono, packet, frustum, mft, cone, mft-cone or reference.
+    /// Traversal method: mono, packet, frustum, mft, cone, mft-cone, mbvh, mbvh-rs or reference.
     #[arg(long, default_value = "mono")]
     pub method: raylab_core::method::Method,
-    /// Tile edge in pixels: the frustum size of frustum methods, the unit threads take for all.
+    /// Tile edge in pixels: the frustum size of frustum methods, the ray group of mbvh-rs (16: 2^8 rays), the
+    /// unit threads take for all.
     #[arg(long, default_value_t = 16, value_parser = in_range(1, 256))]
     pub tile: u64,
     /// Turn packet/leaf culling off (frustum methods).
@@ -214,6 +215,9 @@ pub struct MethodArgs {
     /// frustum; wider ones go as 2x2 packets. 0 traces all shadow rays as packets.
     #[arg(long, default_value_t = raylab_core::trace::TraceOptions::SHADOW_SPREAD_LIMIT, value_parser = parse_non_negative)]
     pub shadow_spread_limit: f32,
+    /// Walk MBVH RS child tasks in lane order instead of by accumulated hit length (to measure the ordering).
+    #[arg(long)]
+    pub no_stream_order: bool,
 }
 
 /// Shadow-technique and recursion flags shared by `render`, `compare` and the viewer (thesis chapter 5,
@@ -254,6 +258,7 @@ impl MethodArgs {
             cull: !self.no_cull,
             backend: self.backend.unwrap_or_else(raylab_simd::Backend::detect),
             shadow_spread_limit: self.shadow_spread_limit,
+            stream_order: !self.no_stream_order,
         }
     }
 }

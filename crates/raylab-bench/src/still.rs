@@ -46,7 +46,7 @@ pub fn render_still(
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     let t0 = Instant::now();
     let reference = (options.method == Method::Reference).then(|| BruteForce::new(&loaded));
-    let mbvh = (options.method == Method::Mbvh).then(|| pool.install(|| Mbvh::build(&loaded)));
+    let mbvh = options.method.uses_mbvh().then(|| pool.install(|| Mbvh::build(&loaded)));
     let frame = {
         let mut tracer = Tracer::new(&tree, reference.as_ref(), options);
         if let Some(m) = &mbvh {

@@ -30,13 +30,16 @@ pub enum Method {
     MftCone,
     /// One ray at a time through the 4-wide MBVH, four boxes per SIMD test (MBVH RS paper, section 3.1).
     Mbvh,
+    /// MBVH ray stream tracing: each tile is one group of rays walked breadth-first (MBVH RS paper,
+    /// Algorithm 1); the tile size sets the group size (16x16 = 2^8).
+    MbvhRs,
     /// Every ray against every triangle; for testing only.
     Reference,
 }
 
 impl Method {
     /// All methods, in the order menus list them.
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 9] = [
         Method::Mono,
         Method::Packet,
         Method::Frustum,
@@ -44,6 +47,7 @@ impl Method {
         Method::Cone,
         Method::MftCone,
         Method::Mbvh,
+        Method::MbvhRs,
         Method::Reference,
     ];
 
@@ -57,6 +61,7 @@ impl Method {
             Method::Cone => "cone",
             Method::MftCone => "mft-cone",
             Method::Mbvh => "mbvh",
+            Method::MbvhRs => "mbvh-rs",
             Method::Reference => "reference",
         }
     }
@@ -66,9 +71,15 @@ impl Method {
         matches!(self, Method::Packet | Method::Frustum | Method::Mft | Method::Cone | Method::MftCone)
     }
 
-    /// True for the methods whose cost depends on the tile size (frustums).
+    /// True for the methods whose cost depends on the tile size (frustums, and ray streams, whose group is
+    /// the tile).
     pub fn uses_tiles(self) -> bool {
-        matches!(self, Method::Frustum | Method::Mft | Method::Cone | Method::MftCone)
+        matches!(self, Method::Frustum | Method::Mft | Method::Cone | Method::MftCone | Method::MbvhRs)
+    }
+
+    /// True for the methods that trace with the MBVH.
+    pub fn uses_mbvh(self) -> bool {
+        matches!(self, Method::Mbvh | Method::MbvhRs)
     }
 }
 

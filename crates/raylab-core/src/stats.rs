@@ -32,6 +32,13 @@ pub struct TraversalStats {
     /// SIMD tests of a ray against a node's four boxes (MBVH traversal; MBVH RS paper, Figure 4).
     #[serde(default)]
     pub box_tests: u64,
+    /// Rays packed into temporary packets at MBVH RS leaves.
+    #[serde(default)]
+    pub leaf_rays: u64,
+    /// Lanes of those packets at SIMD widths 4, 8 and 16 (`leaf_rays` over these is the SIMD utilisation;
+    /// MBVH RS paper, Figure 6).
+    #[serde(default)]
+    pub leaf_slots: [u64; 3],
     /// Shadow rays that first tested a cached blocker (the shadow cache).
     #[serde(default)]
     pub cache_lookups: u64,
@@ -50,6 +57,10 @@ impl AddAssign for TraversalStats {
         self.packets_culled += o.packets_culled;
         self.packets_tested += o.packets_tested;
         self.box_tests += o.box_tests;
+        self.leaf_rays += o.leaf_rays;
+        for (a, b) in self.leaf_slots.iter_mut().zip(o.leaf_slots) {
+            *a += b;
+        }
         self.cache_lookups += o.cache_lookups;
         self.cache_hits += o.cache_hits;
     }
@@ -69,6 +80,11 @@ impl TraversalStats {
     /// Average triangle tests per ray.
     pub fn isects_per_ray(&self) -> f64 {
         ratio(self.isect_tests, self.rays)
+    }
+
+    /// SIMD utilisation of MBVH RS leaf packets at widths 4, 8 and 16, in percent.
+    pub fn leaf_utilisation(&self) -> [f64; 3] {
+        self.leaf_slots.map(|s| 100.0 * ratio(self.leaf_rays, s))
     }
 
     /// Share of shadow-cache lookups that hit (0 when there were none).
@@ -106,6 +122,8 @@ mod tests {
             packets_culled: 0,
             packets_tested: 0,
             box_tests: 0,
+            leaf_rays: 0,
+            leaf_slots: [0; 3],
             cache_lookups: 1,
             cache_hits: 1,
         };
@@ -118,6 +136,8 @@ mod tests {
             packets_culled: 1,
             packets_tested: 3,
             box_tests: 0,
+            leaf_rays: 0,
+            leaf_slots: [0; 3],
             cache_lookups: 3,
             cache_hits: 0,
         };

@@ -164,3 +164,45 @@ fn every_triangle_is_in_exactly_one_leaf_and_lanes_are_well_formed() {
         assert_eq!(m.intersect(&r, &mut s).map(|h| h.t), bf.intersect(&r, &mut s).map(|h| h.t), "{r:?}");
     }
 }
+
+/// MBVH RS (ray streams) against brute force: incoherent groups of every size from 2^4 to 2^12, with and
+/// without the ordering heuristic, closest hits and occlusion.
+#[test]
+fn ray_streams_match_brute_force() {
+    use raylab_core::method::Method;
+    use raylab_core::trace::{TraceOptions, Tracer};
+    for name in ["atrium", "forest"] {
+        let scene = builtin::build(name, Detail::Test).unwrap();
+        let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let m = Mbvh::build(&scene);
+        let bf = BruteForce::new(&scene);
+        let rays: Vec<Option<Ray>> = incoherent(&scene, 4096, 23).into_iter().map(Some).collect();
+        for (group, ordered) in [(16, true), (256, true), (256, false), (4096, true)] {
+            let opts = TraceOptions { method: Method::MbvhRs, stream_order: ordered, ..TraceOptions::default() };
+            let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
+            let mut s = TraversalStats::default();
+            for chunk in rays.chunks(group) {
+                let mut hits = vec![None; chunk.len()];
+                let mut blocked = vec![false; chunk.len()];
+                tracer.intersect_tile(chunk, chunk.len(), 1, &mut hits, &mut s);
+                tracer.occluded_tile(chunk, chunk.len(), 1, None, &mut blocked, &mut s);
+                for ((r, h), b) in chunk.iter().zip(&hits).zip(&blocked) {
+                    let r = r.unwrap();
+                    let want = bf.intersect(&r, &mut TraversalStats::default());
+                    match (h, want) {
+                        (Some(h), Some(w)) => assert!(
+                            (h.t - w.t).abs() <= 1e-5 * w.t.abs().max(1e-30),
+                            "{name} group {group}: {r:?}: {h:?} vs {w:?}"
+                        ),
+                        (h, w) => assert_eq!(*h, w, "{name} group {group}: {r:?}"),
+                    }
+                    assert_eq!(*b, bf.occluded(&r, &mut TraversalStats::default()), "{name} group {group}: {r:?}");
+                }
+            }
+            assert_eq!(s.rays, 2 * 4096);
+            assert!(s.box_tests > 0 && s.leaf_rays > 0);
+            let u = s.leaf_utilisation();
+            assert!(u[0] >= u[1] && u[1] >= u[2] && u[0] <= 100.0, "{u:?}");
+        }
+    }
+}

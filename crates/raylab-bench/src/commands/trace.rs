@@ -2,7 +2,6 @@
 
 use clap::Args;
 use raylab_core::mbvh::Mbvh;
-use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
 use raylab_core::trace::Tracer;
 use raylab_core::workload::{RayKind, WorkloadBuilder};
@@ -64,7 +63,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     });
     let workload = builder.build(a.kind);
     let options = a.m.options();
-    let mbvh = (options.method == Method::Mbvh).then(|| {
+    let mbvh = options.method.uses_mbvh().then(|| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string());
         pool.map(|p| with_spinner("building MBVH", || p.install(|| Mbvh::build(&scene))))
     });

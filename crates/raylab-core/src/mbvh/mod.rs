@@ -1,9 +1,10 @@
 //! The 4-wide bounding volume hierarchy ("MBVH") of the MBVH RS paper (Tsakok 2009, seed 001): build, node
-//! layout and single-ray traversal.
+//! layout, single-ray traversal and ray stream tracing (MBVH RS).
 
 mod build;
 mod node;
 mod single;
+mod stream;
 
 pub use node::{EMPTY, MbvhNode};
 

@@ -34,6 +34,9 @@ pub struct TraceOptions {
     /// from the light) that the frustum methods trace as a frustum; wider tiles or quadrants, whose hit points
     /// are spread in depth, are traced as 2x2 packets instead, which is faster for them.
     pub shadow_spread_limit: f32,
+    /// Order MBVH RS child tasks by accumulated hit length (the paper's heuristic; off walks them in lane
+    /// order, to measure its gain).
+    pub stream_order: bool,
 }
 
 fn backend_name<S: serde::Serializer>(b: &Backend, s: S) -> Result<S::Ok, S::Error> {
@@ -52,6 +55,7 @@ impl Default for TraceOptions {
             cull: true,
             backend: Backend::detect(),
             shadow_spread_limit: Self::SHADOW_SPREAD_LIMIT,
+            stream_order: true,
         }
     }
 }
@@ -99,7 +103,7 @@ impl<'a> Tracer<'a> {
     pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         match self.options.method {
             Method::Reference => self.reference().occluder(ray, stats),
-            Method::Mbvh => self.mbvh().occluder(ray, stats),
+            Method::Mbvh | Method::MbvhRs => self.mbvh().occluder(ray, stats),
             _ => self.tree.occluder(ray, stats),
         }
     }
@@ -154,6 +158,7 @@ impl<'a> Tracer<'a> {
                     *o = r.and_then(|r| m.intersect(&r, stats));
                 }
             }
+            Method::MbvhRs => self.mbvh().intersect_stream(rays, out, self.options.stream_order, stats),
             _ => match self.options.backend {
                 #[cfg(target_arch = "x86_64")]
                 Backend::Sse => self.intersect_simd::<raylab_simd::sse::F32x4>(rays, width, height, out, stats),
@@ -191,6 +196,7 @@ impl<'a> Tracer<'a> {
                     *o = r.is_some_and(|r| m.occluded(&r, stats));
                 }
             }
+            Method::MbvhRs => self.mbvh().occluded_stream(rays, out, self.options.stream_order, stats),
             _ => match self.options.backend {
                 #[cfg(target_arch = "x86_64")]
                 Backend::Sse => self.occluded_simd::<raylab_simd::sse::F32x4>(rays, width, height, toward, out, stats),

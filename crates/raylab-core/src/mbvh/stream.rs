@@ -1,0 +1,209 @@
+//! MBVH ray stream tracing, "MBVH RS" (Tsakok 2009, Algorithm 1 and Listing 1): a whole group of rays walks
+//! the 4-wide tree breadth-first. Each task is (node, lane, count): the `count` ray ids on top of lane
+//! `lane`'s active-ray stack reached `node`. Every such ray is tested against the node's four boxes at once and
+//! its id pushed onto the stack of each lane it hits; tasks for the children then go on the task stack,
+//! ordered by the hit distances accumulated per lane (nearest last, so it is walked first). At a leaf the
+//! active rays are packed four at a time into temporary SoA packets and tested against one triangle per step.
+//! Shadow rays leave the stream at their first hit.
+
+use raylab_simd::{VMask, Vf32};
+
+use super::Mbvh;
+use super::single::RaySlab;
+use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
+use crate::ray::{Hit, Ray};
+use crate::stats::TraversalStats;
+
+/// A pending task: `count` rays on top of lane `lane`'s stack reached child `child` (a node, or a leaf when
+/// `tris > 0`).
+#[derive(Clone, Copy)]
+struct Task {
+    child: u32,
+    tris: u32,
+    lane: u8,
+    count: u32,
+}
+
+/// Per-ray state of a stream.
+struct Slot<V: Vf32> {
+    slab: RaySlab<V>,
+    ray: Ray,
+    /// Current far limit: the closest hit so far (or `tmax`).
+    best: f32,
+    hit: Option<Hit>,
+    blocked: bool,
+}
+
+impl Mbvh {
+    /// Closest hits of a group of rays traced together (`None` rays are skipped). `ordered` turns on the
+    /// accumulated-length ordering of child tasks.
+    pub fn intersect_stream(&self, rays: &[Option<Ray>], out: &mut [Option<Hit>], ordered: bool, stats: &mut TraversalStats) {
+        match self.backend {
+            #[cfg(target_arch = "x86_64")]
+            raylab_simd::Backend::Sse => self.stream::<raylab_simd::sse::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit),
+            _ => self.stream::<raylab_simd::scalar::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit),
+        }
+    }
+
+    /// Occlusion of a group of rays traced together; each ray leaves the stream at its first blocker.
+    pub fn occluded_stream(&self, rays: &[Option<Ray>], out: &mut [bool], ordered: bool, stats: &mut TraversalStats) {
+        match self.backend {
+            #[cfg(target_arch = "x86_64")]
+            raylab_simd::Backend::Sse => {
+                self.stream::<raylab_simd::sse::F32x4>(rays, true, ordered, stats, |i, s| out[i] = s.blocked)
+            }
+            _ => self.stream::<raylab_simd::scalar::F32x4>(rays, true, ordered, stats, |i, s| out[i] = s.blocked),
+        }
+    }
+
+    fn stream<V: Vf32>(
+        &self,
+        rays: &[Option<Ray>],
+        shadow: bool,
+        ordered: bool,
+        stats: &mut TraversalStats,
+        mut emit: impl FnMut(usize, &Slot<V>),
+    ) {
+        assert_eq!(V::LANES, 4, "MBVH RS packs leaf rays four at a time");
+        let mut slots: Vec<Slot<V>> = Vec::with_capacity(rays.len());
+        let mut ids: Vec<u32> = Vec::with_capacity(rays.len());
+        for (i, r) in rays.iter().enumerate() {
+            let ray = r.unwrap_or(Ray::new(glam::Vec3::ZERO, glam::Vec3::Z));
+            let live = r.is_some_and(|r| r.is_valid());
+            slots.push(Slot { slab: RaySlab::new(&ray), ray, best: ray.tmax, hit: None, blocked: false });
+            if live {
+                ids.push(i as u32);
+            }
+        }
+        stats.rays += ids.len() as u64;
+        stats.packets += ids.len().div_ceil(4) as u64;
+        if !self.tri_ids.is_empty() && !ids.is_empty() {
+            self.walk_stream(&mut slots, ids, shadow, ordered, stats);
+        }
+        for (i, s) in slots.iter().enumerate() {
+            emit(i, s);
+        }
+    }
+
+    fn walk_stream<V: Vf32>(
+        &self,
+        slots: &mut [Slot<V>],
+        ids: Vec<u32>,
+        shadow: bool,
+        ordered: bool,
+        stats: &mut TraversalStats,
+    ) {
+        let n = ids.len() as u32;
+        let mut lanes: [Vec<u32>; 4] = [ids, Vec::new(), Vec::new(), Vec::new()];
+        let mut tasks: Vec<Task> = vec![Task { child: 0, tris: 0, lane: 0, count: n }];
+        let mut current: Vec<u32> = Vec::new();
+        let (mut fetches, mut box_tests, mut leaves, mut tests) = (0u64, 0u64, 0u64, 0u64);
+        let (mut leaf_rays, mut slots4, mut slots8, mut slots16) = (0u64, 0u64, 0u64, 0u64);
+        while let Some(task) = tasks.pop() {
+            let stack = &mut lanes[task.lane as usize];
+            let start = stack.len() - task.count as usize;
+            current.clear();
+            current.extend(stack.drain(start..));
+            if task.tris > 0 {
+                leaves += 1;
+                let live: Vec<u32> = current.iter().copied().filter(|&i| !slots[i as usize].blocked).collect();
+                let c = live.len() as u64;
+                leaf_rays += c;
+                slots4 += c.div_ceil(4) * 4;
+                slots8 += c.div_ceil(8) * 8;
+                slots16 += c.div_ceil(16) * 16;
+                let tri_ids = &self.tri_ids[task.child as usize..(task.child + task.tris) as usize];
+                for group in live.chunks(4) {
+                    tests += self.leaf_packet(slots, group, tri_ids, shadow);
+                }
+                continue;
+            }
+            fetches += 1;
+            let node = &self.nodes[task.child as usize];
+            let mut counts = [0u32; 4];
+            let mut lengths = [0f32; 4];
+            for &id in &current {
+                let s = &slots[id as usize];
+                if s.blocked {
+                    continue;
+                }
+                box_tests += 1;
+                let (near, mask) = s.slab.test(node, s.ray.tmin, s.best);
+                let bits = mask.bits() & node.used;
+                if bits == 0 {
+                    continue;
+                }
+                let mut dist = [0f32; 4];
+                near.write_to(&mut dist);
+                for k in 0..4 {
+                    if bits >> k & 1 == 1 {
+                        lanes[k].push(id);
+                        counts[k] += 1;
+                        lengths[k] += dist[k];
+                    }
+                }
+            }
+            // Children with the largest accumulated length first on the stack, so the shortest is walked first.
+            let mut order = [0usize, 1, 2, 3];
+            if ordered {
+                order.sort_unstable_by(|&a, &b| lengths[b].total_cmp(&lengths[a]));
+            }
+            for k in order {
+                if counts[k] > 0 {
+                    tasks.push(Task { child: node.child[k], tris: node.count[k], lane: k as u8, count: counts[k] });
+                }
+            }
+        }
+        stats.nodes += fetches;
+        stats.box_tests += box_tests;
+        stats.leaves += leaves;
+        stats.isect_tests += tests;
+        stats.leaf_rays += leaf_rays;
+        stats.leaf_slots[0] += slots4;
+        stats.leaf_slots[1] += slots8;
+        stats.leaf_slots[2] += slots16;
+    }
+
+    /// Tests up to four rays, packed into a temporary SoA packet, against the leaf's triangles; returns the
+    /// number of packet/triangle tests.
+    fn leaf_packet<V: Vf32>(&self, slots: &mut [Slot<V>], group: &[u32], tri_ids: &[u32], shadow: bool) -> u64 {
+        let mut rays = [None; 4];
+        for (r, &id) in rays.iter_mut().zip(group) {
+            let s = &slots[id as usize];
+            *r = Some(Ray { tmax: s.best, ..s.ray });
+        }
+        let p = RayPacket::<V>::new(&rays[..group.len()]);
+        let mut tests = 0;
+        if shadow {
+            let mut open = p.valid;
+            for &tri in tri_ids {
+                tests += 1;
+                open = open & !occlude_packet(&p, self.tris.get(tri), open);
+                if open.none() {
+                    break;
+                }
+            }
+            let blocked = p.valid.bits() & !open.bits();
+            for (k, &id) in group.iter().enumerate() {
+                if blocked >> k & 1 == 1 {
+                    slots[id as usize].blocked = true;
+                }
+            }
+        } else {
+            let mut hits = PacketHits::new(&p);
+            for &tri in tri_ids {
+                tests += 1;
+                intersect_packet(&p, &mut hits, self.tris.get(tri), tri, p.valid);
+            }
+            let found = hits.to_hits();
+            for (k, &id) in group.iter().enumerate() {
+                if let Some(h) = found[k] {
+                    let s = &mut slots[id as usize];
+                    s.best = h.t;
+                    s.hit = Some(h);
+                }
+            }
+        }
+        tests
+    }
+}
