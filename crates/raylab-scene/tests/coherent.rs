@@ -76,7 +76,8 @@ fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what
             {
                 for tile in TILES {
                     // An infinite spread limit sends every shadow tile down the frustum path.
-                    let opts = TraceOptions { method, cull, backend, shadow_spread_limit: spread, ..TraceOptions::default() };
+                    let opts =
+                        TraceOptions { method, cull, backend, shadow_spread_limit: spread, ..TraceOptions::default() };
                     let tracer = Tracer::new(&tree, None, opts);
                     let (hits, _) = trace_image(&tracer, &primary, w, h, tile, None);
                     let (_, occ) = trace_image(&tracer, &shadow, w, h, tile, Some(light));

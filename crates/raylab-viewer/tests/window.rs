@@ -148,7 +148,14 @@ fn window_shows_the_traced_frame_unchanged_for_every_method_and_shadow_technique
     }
     // The soft techniques, each with one method (the method changes no pixels; tests/shadows.rs in
     // raylab-scene proves that for every pair).
-    for (method, flag) in [(Method::Packet, "cached"), (Method::Mft, "edge"), (Method::Mono, "ms4")] {
+    // The MBVH methods, which the viewer builds an MBVH for, ride along here.
+    for (method, flag) in [
+        (Method::Packet, "cached"),
+        (Method::Mft, "edge"),
+        (Method::Mono, "ms4"),
+        (Method::Mbvh, "hard"),
+        (Method::MbvhRs, "hard"),
+    ] {
         let name = format!("{method}-{flag}");
         let (shot, stats) = run_viewer(dir.path(), &name, false, &["--method", method.name(), "--shadows", flag]);
         check(&name, &shot, &stats, &reference(method, flag.parse().unwrap(), FrameView::Shaded));

@@ -37,10 +37,18 @@ struct Slot<V: Vf32> {
 impl Mbvh {
     /// Closest hits of a group of rays traced together (`None` rays are skipped). `ordered` turns on the
     /// accumulated-length ordering of child tasks.
-    pub fn intersect_stream(&self, rays: &[Option<Ray>], out: &mut [Option<Hit>], ordered: bool, stats: &mut TraversalStats) {
+    pub fn intersect_stream(
+        &self,
+        rays: &[Option<Ray>],
+        out: &mut [Option<Hit>],
+        ordered: bool,
+        stats: &mut TraversalStats,
+    ) {
         match self.backend {
             #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse => self.stream::<raylab_simd::sse::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit),
+            raylab_simd::Backend::Sse => {
+                self.stream::<raylab_simd::sse::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit)
+            }
             _ => self.stream::<raylab_simd::scalar::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit),
         }
     }

@@ -182,6 +182,12 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
         let frustums = s.trace.method.uses_tiles();
         ui.add_enabled(frustums, egui::Checkbox::new(&mut s.trace.cull, "packet/leaf culling"))
             .on_disabled_hover_text("only the frustum methods cull packets at leaves");
+        ui.add_enabled(
+            s.trace.method == Method::MbvhRs,
+            egui::Checkbox::new(&mut s.trace.stream_order, "stream ordering"),
+        )
+        .on_hover_text("walk MBVH RS children by accumulated hit length (the paper's heuristic)")
+        .on_disabled_hover_text("only mbvh-rs orders its child tasks");
         egui::ComboBox::from_label("SIMD").selected_text(s.trace.backend.name()).show_ui(ui, |ui| {
             for b in Backend::available() {
                 ui.selectable_value(&mut s.trace.backend, b, b.name());
