@@ -147,7 +147,8 @@ fn textures_materials_cameras_and_lights() {
     let extra = json!({
         "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior"],
         "images": [{ "uri": "tex/red.png" }, { "uri": data_uri(&png_bytes([128, 128, 255])) }],
-        "textures": [{ "source": 0 }, { "source": 1 }],
+        "samplers": [{ "wrapS": 33071, "wrapT": 33071 }],
+        "textures": [{ "source": 0, "sampler": 0 }, { "source": 1 }],
         "materials": [
             { "name": "tiles", "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 }, "roughnessFactor": 1.0, "metallicFactor": 0 }, "normalTexture": { "index": 1 } },
             { "name": "chrome", "pbrMetallicRoughness": { "metallicFactor": 1.0, "roughnessFactor": 0.1 } },
@@ -176,6 +177,7 @@ fn textures_materials_cameras_and_lights() {
     let tiles = m("tiles");
     let base = &scene.textures[tiles.diffuse_texture.unwrap() as usize];
     assert_eq!(base.texels[0], Vec3::X, "sRGB red is linear red");
+    assert_eq!(base.wrap, raylab_core::scene::WrapMode::Clamp, "the sampler's CLAMP_TO_EDGE");
     let normal = &scene.textures[tiles.normal_texture.unwrap() as usize];
     assert!((normal.texels[0].x - 128.0 / 255.0).abs() < 1e-6, "normal maps stay linear");
     assert_eq!(m("chrome").kind, MaterialKind::Reflective);

@@ -72,7 +72,7 @@ fn materials_map_onto_the_fixed_function_kinds() {
          newmtl shiny\nKd 1 1 1\nKs 0.5 0.5 0.5\nNs 64\nillum 2\nnorm ../textures/normals.png\n\
          newmtl mirror\nKs 0.9 0.9 0.9\nillum 3\n\
          newmtl glass\nNi 1.33\nd 0.2\nillum 7\n\
-         newmtl veil\nd 0.5\n",
+         newmtl veil\nd 0.5\nmap_Kd -clamp on ../textures/normals.png\n",
     );
     let mut text = String::from("mtllib materials/lib.mtl\n");
     for (k, m) in ["matte", "shiny", "mirror", "glass", "veil"].iter().enumerate() {
@@ -97,6 +97,9 @@ fn materials_map_onto_the_fixed_function_kinds() {
     assert_eq!(m("glass").kind, MaterialKind::TransparentReflective);
     assert!((m("glass").ior - 1.33).abs() < 1e-6 && (m("glass").transmit_blend - 0.8).abs() < 1e-6);
     assert_eq!(m("veil").kind, MaterialKind::Transparent);
+    let clamped = &scene.textures[m("veil").diffuse_texture.unwrap() as usize];
+    assert_eq!(clamped.wrap, raylab_core::scene::WrapMode::Clamp, "-clamp on");
+    assert_eq!(wall.wrap, raylab_core::scene::WrapMode::Repeat);
 }
 
 #[test]

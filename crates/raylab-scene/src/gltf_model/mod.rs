@@ -16,7 +16,7 @@ use std::path::Path;
 use glam::{Mat4, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
-use raylab_core::scene::{Camera, Material, PointLight, SceneBuilder, TextureId, Triangle, View};
+use raylab_core::scene::{Camera, Material, PointLight, SceneBuilder, TextureId, Triangle, View, WrapMode};
 
 use crate::texture::{TextureSet, TextureUse};
 use crate::{Loaded, SceneError};
@@ -75,12 +75,18 @@ pub fn load(path: &Path) -> Result<Loaded, SceneError> {
     }
 
     let mut textures = TextureSet::default();
-    let mut images: HashMap<(usize, TextureUse), TextureId> = HashMap::new();
+    let mut images: HashMap<(usize, TextureUse, WrapMode), TextureId> = HashMap::new();
     let mut image = |texture: gltf::Texture, usage: TextureUse, textures: &mut TextureSet| -> TextureId {
         let img = texture.source();
-        *images.entry((img.index(), usage)).or_insert_with(|| {
+        // One wrap mode per texture here: the sampler's S mode.
+        let wrap = match texture.sampler().wrap_s() {
+            gltf::texture::WrappingMode::ClampToEdge => WrapMode::Clamp,
+            gltf::texture::WrappingMode::MirroredRepeat => WrapMode::Mirror,
+            gltf::texture::WrappingMode::Repeat => WrapMode::Repeat,
+        };
+        *images.entry((img.index(), usage, wrap)).or_insert_with(|| {
             let name = img.name().map_or_else(|| format!("{} image {}", path.display(), img.index()), str::to_string);
-            match img.source() {
+            let id = match img.source() {
                 gltf::image::Source::View { view, .. } => {
                     let data = buffers
                         .get(view.buffer().index())
@@ -94,7 +100,9 @@ pub fn load(path: &Path) -> Result<Loaded, SceneError> {
                     Ok(d) => textures.bytes(&name, &d, usage),
                     Err(why) => textures.refused(&name, format!("image {name}: {why}")),
                 },
-            }
+            };
+            textures.textures[id as usize].wrap = wrap;
+            id
         })
     };
 

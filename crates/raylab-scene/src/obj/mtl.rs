@@ -9,12 +9,13 @@
 //! | `illum` 4, 6, 7 or 9 (glass, refraction) | TransparentReflective: transmission 1 - `d` (0.9 when `d` is 1), index `Ni`, Fresnel reflection |
 //! | `map_bump`, `bump`, `norm` | a normal map; a grey (height) image is turned into one |
 //!
-//! Texture options before the file name (`-bm 0.5 file.png`) are skipped: the last word is the file.
+//! Texture options before the file name (`-bm 0.5 file.png`) are skipped, the last word being the file, except
+//! `-clamp on`, which clamps the texture's coordinates instead of repeating it.
 
 use std::path::Path;
 
 use glam::Vec3;
-use raylab_core::scene::{Material, MaterialKind};
+use raylab_core::scene::{Material, MaterialKind, WrapMode};
 
 use crate::texture::{TextureSet, TextureUse};
 
@@ -43,11 +44,17 @@ pub fn convert(
         _ => MaterialKind::Diffuse,
     };
     let mut texture = |reference: &Option<String>, usage: TextureUse| {
-        let name = reference.as_deref().and_then(|r| r.split_whitespace().last())?;
-        Some(match crate::paths::resolve(root, mtl_dir, name) {
+        let words: Vec<&str> = reference.as_deref()?.split_whitespace().collect();
+        let name = *words.last()?;
+        let clamp = words.windows(2).any(|w| w[0] == "-clamp" && w[1] == "on");
+        let id = match crate::paths::resolve(root, mtl_dir, name) {
             Ok(file) => textures.file(&file, usage),
             Err(why) => textures.refused(name, format!("material '{}': texture refused: {why}", m.name)),
-        })
+        };
+        if clamp {
+            textures.textures[id as usize].wrap = WrapMode::Clamp;
+        }
+        Some(id)
     };
     let diffuse_texture = texture(&m.diffuse_texture, TextureUse::Color);
     let normal_texture = match m.unknown_param.get("norm") {
