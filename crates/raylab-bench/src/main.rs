@@ -26,6 +26,8 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Run the Embree harness and raylab on the same view in one go, and print the comparison table.
     Compare(commands::compare::CompareArgs),
+    /// Trace the MBVH RS paper's distribution workload with several methods: Mrays/s per bounce and counters.
+    Distribution(commands::distribution::DistributionArgs),
     /// Regenerate the thesis's Tables 4.1-4.5 (FPS, N, I per method and tile) for the built-in scenes.
     Tables(commands::tables::TablesArgs),
 }
@@ -39,6 +41,7 @@ fn main() -> std::process::ExitCode {
         Some(Command::Info(a)) => commands::info::run(a),
         Some(Command::Compare(a)) => commands::compare::run(a),
         Some(Command::Tables(a)) => commands::tables::run(a),
+        Some(Command::Distribution(a)) => commands::distribution::run(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -253,3 +253,36 @@ fn info_lists_materials_textures_and_warnings() {
     assert_eq!(v["textures"][0]["width"], 6);
     assert_eq!(v["warnings"].as_array().unwrap().len(), 1);
 }
+
+#[test]
+fn distribution_prints_per_bounce_speeds_for_each_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = bench(
+        &[
+            "distribution",
+            "--scene",
+            "arena",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            "4",
+            "--bounces",
+            "2",
+            "--groups",
+            "2,4",
+            "--out",
+            "d.png",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for want in ["| mono |", "| packet |", "| mbvh |", "| mbvh-rs | 64 |", "| mbvh-rs | 16 |", "bounce 2"] {
+        assert!(out.contains(want), "missing '{want}' in:\n{out}");
+    }
+    assert!(dir.path().join("d.png").is_file());
+    let o = bench(&["distribution", "--scene", "arena", "--bounces", "9"], dir.path());
+    assert!(!o.status.success() && stderr(&o).contains("1..=7"));
+}

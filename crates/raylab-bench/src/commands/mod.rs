@@ -1,6 +1,7 @@
 //! The subcommands.
 
 pub mod compare;
+pub mod distribution;
 pub mod info;
 pub mod render;
 pub mod shading_tables;

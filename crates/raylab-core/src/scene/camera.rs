@@ -91,7 +91,16 @@ impl Camera {
         let u = r.cross(f);
         let s = (self.vfov_deg as f64 * std::f64::consts::PI / 360.0).tan();
         let aspect = width as f64 / height as f64;
-        CameraRaster { eye: self.eye, f, r: r * (s * aspect), u: u * s, width: width as f64, height: height as f64 }
+        CameraRaster {
+            eye: self.eye,
+            f,
+            r: r * (s * aspect),
+            u: u * s,
+            width: width as f64,
+            height: height as f64,
+            aperture: if self.aperture.is_finite() { self.aperture.max(0.0) } else { 0.0 },
+            focus_distance: self.focus_distance,
+        }
     }
 }
 
@@ -108,9 +117,26 @@ pub struct CameraRaster {
     u: DVec3,
     width: f64,
     height: f64,
+    aperture: f32,
+    focus_distance: f32,
 }
 
 impl CameraRaster {
+    /// A thin-lens ray through raster position `(px, py)` from the lens point `lens` (in the unit disc, scaled
+    /// by the aperture radius): it passes through the point the pinhole ray meets on the plane in focus.
+    /// With no aperture it is the pinhole ray.
+    pub fn lens_ray(&self, px: f64, py: f64, lens: glam::Vec2) -> Ray {
+        let pin = self.primary_at(px, py);
+        if self.aperture <= 0.0 || self.focus_distance.is_nan() || self.focus_distance <= 0.0 {
+            return pin;
+        }
+        let forward = self.f.as_vec3();
+        let focus = pin.origin + pin.dir * (self.focus_distance / pin.dir.dot(forward));
+        let (right, up) = (self.r.normalize().as_vec3(), self.u.normalize().as_vec3());
+        let origin = self.eye + (right * lens.x + up * lens.y) * self.aperture;
+        Ray::new(origin, (focus - origin).normalize())
+    }
+
     /// The primary ray through the centre of pixel `(x, y)`.
     pub fn primary(&self, x: u32, y: u32) -> Ray {
         self.primary_at(x as f64 + 0.5, y as f64 + 0.5)

@@ -10,7 +10,7 @@ mod samples;
 
 pub use cache::ShadowCache;
 pub use edge_width::{Crossing, EdgeWidth};
-pub use samples::{LightSamples, stratified_grid};
+pub use samples::{LightSamples, concentric_disc, stratified_grid};
 
 use std::fmt;
 use std::str::FromStr;
