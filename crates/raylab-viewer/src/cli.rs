@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use clap::{Parser, ValueEnum};
-use raylab_bench::args::{KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_positive};
+use raylab_bench::args::{KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_non_negative, parse_positive};
 use raylab_core::render::{FrameView, RayOrder};
 
 use crate::settings::RenderMode;
@@ -21,9 +21,18 @@ pub struct Cli {
     pub method: MethodArgs,
     #[command(flatten)]
     pub shade: ShadeArgs,
-    /// Render mode.
+    /// Render mode: whitted, or distribution (glossy paths, soft shadows, depth of field, refined over frames).
     #[arg(long, value_enum, default_value_t = RenderMode::Whitted)]
     pub mode: RenderMode,
+    /// Distribution mode: bounces after the primary hit.
+    #[arg(long, default_value_t = 3, value_parser = in_range(1, 7))]
+    pub bounces: u64,
+    /// Distribution mode: paths per pixel added each frame.
+    #[arg(long, default_value_t = 4, value_parser = in_range(1, 256))]
+    pub paths_per_pass: u64,
+    /// Distribution mode: lens radius of the camera (0: pinhole).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative, allow_hyphen_values = true)]
+    pub aperture: f32,
     /// Pixel order inside a tile (single-ray methods): scanline, morton or hilbert.
     #[arg(long, default_value = "scanline")]
     pub order: RayOrder,

@@ -129,6 +129,8 @@ struct StatsFile<'a> {
     panel_rect: Option<[f32; 4]>,
     /// Everything the UI drew over the traced image (the panel first), in pixels.
     ui_rects: &'a [[f32; 4]],
+    /// In distribution mode, the paths per pixel in the last frame.
+    paths: Option<u32>,
     readouts: StatsReport,
 }
 
@@ -157,6 +159,7 @@ impl Automation {
                 settings: latest.settings,
                 panel_rect: lab.panel_rect,
                 ui_rects: &lab.ui_rects,
+                paths: latest.paths,
                 readouts: lab.readouts.report(),
             };
             let json = serde_json::to_string_pretty(&file).map_err(|e| e.to_string())?;

@@ -51,6 +51,12 @@ fn run(cli: &Cli) -> Result<(), String> {
         tile: cli.method.tile as u32,
         shadows: cli.shade.shadows(&scene.light),
         depth: cli.shade.depth as u32,
+        distribution: crate::settings::DistributionControls {
+            bounces: cli.bounces as u32,
+            paths_per_pass: cli.paths_per_pass as u32,
+            aperture: cli.aperture,
+            ..Default::default()
+        },
         order: cli.order,
         show: cli.show,
         heat_max: cli.heat_max,

@@ -2,6 +2,7 @@
 //! render worker with each job.
 
 use clap::ValueEnum;
+use raylab_core::distribution::DistributionSettings;
 use raylab_core::method::Method;
 use raylab_core::render::{FrameView, RayOrder, RenderSettings};
 use raylab_core::shadow::Shadows;
@@ -16,6 +17,47 @@ pub enum RenderMode {
     /// chosen depth (Whitted-style, thesis 3.3 and 4.2.1).
     #[default]
     Whitted,
+    /// The MBVH RS paper's distribution ray tracer: glossy paths, soft shadows, depth of field, refined
+    /// progressively while the view stays still.
+    Distribution,
+}
+
+/// The distribution ray tracer's controls.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DistributionControls {
+    /// Bounces after the primary hit (1 to 7).
+    pub bounces: u32,
+    /// Paths per pixel added by each pass.
+    pub paths_per_pass: u32,
+    /// Phong exponent of the glossy lobe.
+    pub glossy_exponent: f32,
+    /// Every surface glossy (the paper's benchmark) rather than only the reflective materials.
+    pub all_glossy: bool,
+    /// Lens radius (0: pinhole).
+    pub aperture: f32,
+    /// Passes after which refinement stops.
+    pub max_passes: u32,
+}
+
+impl Default for DistributionControls {
+    fn default() -> Self {
+        Self { bounces: 3, paths_per_pass: 4, glossy_exponent: 64.0, all_glossy: false, aperture: 0.0, max_passes: 256 }
+    }
+}
+
+impl DistributionControls {
+    /// The core settings for a `width x height` frame with tile edge `tile`.
+    pub fn settings(&self, width: u32, height: u32, tile: u32) -> DistributionSettings {
+        DistributionSettings {
+            width,
+            height,
+            tile,
+            spp: self.paths_per_pass.max(1),
+            bounces: self.bounces.clamp(1, 7),
+            glossy_exponent: self.glossy_exponent,
+            all_glossy: self.all_glossy,
+        }
+    }
 }
 
 /// The frame settings the UI controls (and the `--json-stats` file records).
@@ -31,6 +73,8 @@ pub struct ViewerSettings {
     pub shadows: Shadows,
     /// Reflection and refraction depth after the primary hit.
     pub depth: u32,
+    /// Distribution-mode controls.
+    pub distribution: DistributionControls,
     /// Pixel order of single-ray methods.
     pub order: RayOrder,
     /// What the traced image shows.

@@ -7,14 +7,16 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::Instant;
 
+use raylab_core::distribution::{Accumulator, render_pass};
 use raylab_core::method::Method;
-use raylab_core::render::{Frame, render};
+use raylab_core::render::{Frame, StageTimes, render};
 use raylab_core::scene::{Camera, PointLight};
+use raylab_core::stats::TraversalStats;
 use raylab_core::trace::Tracer;
 
 use crate::compare::{CompareRow, compare_configs};
 use crate::loader::LoadedScene;
-use crate::settings::ViewerSettings;
+use crate::settings::{RenderMode, ViewerSettings};
 
 /// One frame to trace.
 #[derive(Clone)]
@@ -39,6 +41,27 @@ pub struct Rendered {
     pub wall_s: f64,
     /// The settings it was traced with.
     pub settings: ViewerSettings,
+    /// In distribution mode, the paths per pixel accumulated in the image.
+    pub paths: Option<u32>,
+}
+
+/// The distribution mode's image in progress and the view it belongs to.
+struct Progressive {
+    job: Job,
+    acc: Accumulator,
+    passes: u32,
+}
+
+impl Progressive {
+    /// True when `job` shows the same view with the same settings (so its passes may be added).
+    fn same_view(&self, job: &Job) -> bool {
+        let (a, b) = (&self.job, job);
+        Arc::ptr_eq(&a.scene, &b.scene)
+            && a.camera == b.camera
+            && a.light == b.light
+            && a.settings == b.settings
+            && a.size == b.size
+    }
 }
 
 /// What the worker reports.
@@ -149,6 +172,7 @@ fn lower_priority() {
 fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
     lower_priority();
     let mut pool: Option<(usize, rayon::ThreadPool)> = None;
+    let mut progressive: Option<Progressive> = None;
     loop {
         let task = {
             let mut st = shared.lock();
@@ -183,6 +207,18 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
         }
         let Some((_, pool)) = pool.as_ref() else { continue };
         match task {
+            Task::Frame(job) if job.settings.mode == RenderMode::Distribution => {
+                if !progressive.as_ref().is_some_and(|p| p.same_view(&job)) {
+                    let acc = Accumulator::new(job.size.0.max(1), job.size.1.max(1));
+                    progressive = Some(Progressive { job: job.clone(), acc, passes: 0 });
+                }
+                let Some(p) = progressive.as_mut() else { continue };
+                let rendered = pool.install(|| distribution_pass(p));
+                // Keep refining while the view stays, up to the pass limit.
+                let more = p.passes < job.settings.distribution.max_passes.max(1);
+                shared.lock().repeat = (more || job.settings.continuous).then(|| job.clone());
+                send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
+            }
             Task::Frame(job) => {
                 let rendered = pool.install(|| trace_frame(&job, job.settings.trace.method));
                 shared.lock().repeat = job.settings.continuous.then(|| job.clone());
@@ -217,5 +253,36 @@ pub fn trace_frame(job: &Job, method: Method) -> Rendered {
         .with_mbvh(&s.mbvh);
     let t0 = Instant::now();
     let frame = render(&s.scene, &tracer, &job.camera, job.light, &settings);
-    Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings }
+    Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings, paths: None }
+}
+
+/// Adds one distribution pass to `p` on the current rayon pool and returns the refined image.
+fn distribution_pass(p: &mut Progressive) -> Rendered {
+    let job = &p.job;
+    let s = &job.scene;
+    let (w, h) = (p.acc.width, p.acc.height);
+    let settings = job.settings.distribution.settings(w, h, job.settings.tile);
+    let tracer = Tracer::new(&s.tree, None, job.settings.trace).with_mbvh(&s.mbvh);
+    let mut camera = job.camera;
+    camera.aperture = job.settings.distribution.aperture;
+    let mut light = job.light;
+    if light.radius <= 0.0 {
+        light.radius = 0.02 * s.scene.bounds().diagonal();
+    }
+    let t0 = Instant::now();
+    let bounces = render_pass(&s.scene, &tracer, &camera, light, &settings, p.passes, &mut p.acc);
+    p.passes += 1;
+    let mut stats = TraversalStats::default();
+    let mut stages = StageTimes::default();
+    for (k, b) in bounces.iter().enumerate() {
+        stats += b.stats;
+        if k == 0 {
+            stages.primary += b.seconds;
+        } else {
+            stages.secondary += b.seconds;
+        }
+        stages.shadow += b.shadow_seconds;
+    }
+    let frame = Frame { width: w, height: h, rgba: p.acc.rgba(), stats, stages, range: None };
+    Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings, paths: Some(p.acc.paths) }
 }

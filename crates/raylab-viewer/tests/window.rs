@@ -175,3 +175,40 @@ fn heat_maps_and_offscreen_runs_match_the_cli() {
     let (shot, stats) = run_viewer(dir.path(), "window-normals", false, &["--method", "packet", "--show", "normals"]);
     check("window-normals", &shot, &stats, &reference(Method::Packet, ShadowKind::Hard, FrameView::Normals));
 }
+
+/// Distribution mode refines one image over frames: the window shows exactly the mean of the passes the core
+/// tracer makes for that view, as many as the stats file says were accumulated.
+#[test]
+fn distribution_mode_shows_the_accumulated_passes() {
+    use raylab_core::distribution::{Accumulator, DistributionSettings, render_pass};
+    use raylab_core::kdtree::KdTree;
+    use raylab_core::mbvh::Mbvh;
+    use raylab_core::trace::Tracer;
+
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["--mode", "distribution", "--bounces", "1", "--paths-per-pass", "2"];
+    let (shot, stats) = run_viewer(dir.path(), "distribution", true, &args);
+    let paths = stats["paths"].as_u64().expect("paths in the stats file") as u32;
+    assert!(paths >= 2 && paths.is_multiple_of(2), "{paths}");
+    let scene_args = SceneArgs::named("atrium");
+    let scene = raylab_scene::load(&scene_args.source()).unwrap().scene;
+    let (camera, light) = scene_args.camera_and_light(&scene).unwrap();
+    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let mbvh = Mbvh::build(&scene);
+    let tracer = Tracer::new(&tree, None, TraceOptions::default()).with_mbvh(&mbvh);
+    let settings = DistributionSettings {
+        width: W,
+        height: H,
+        tile: TILE,
+        spp: 2,
+        bounces: 1,
+        glossy_exponent: 64.0,
+        all_glossy: false,
+    };
+    let mut acc = Accumulator::new(W, H);
+    for pass in 0..paths / 2 {
+        render_pass(&scene, &tracer, &camera, light, &settings, pass, &mut acc);
+    }
+    let want = image::RgbaImage::from_raw(W, H, acc.rgba().as_flattened().to_vec()).unwrap();
+    check("distribution", &shot, &stats, &want);
+}

@@ -506,7 +506,7 @@ mod tests {
     use crate::loader::load_now;
     use raylab_core::shadow::Shadows;
 
-    use crate::settings::RenderMode;
+    use crate::settings::{DistributionControls, RenderMode};
 
     fn lab(method: Method) -> Lab {
         let kd = KdParams::default();
@@ -517,6 +517,7 @@ mod tests {
             tile: 8,
             shadows: Shadows::Hard,
             depth: 3,
+            distribution: DistributionControls::default(),
             order: RayOrder::Scanline,
             show: FrameView::Shaded,
             heat_max: None,

@@ -156,11 +156,24 @@ fn camera_section(lab: &mut Lab, ui: &mut egui::Ui) {
 fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
     let before = lab.settings;
     let light_radius = lab.light.radius;
+    let paths = lab.latest().and_then(|r| r.paths);
     let s = &mut lab.settings;
     egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| {
         egui::ComboBox::from_label("mode").selected_text(value_name(&s.mode)).show_ui(ui, |ui| {
             ui.selectable_value(&mut s.mode, RenderMode::Whitted, "whitted");
+            ui.selectable_value(&mut s.mode, RenderMode::Distribution, "distribution");
         });
+        if s.mode == RenderMode::Distribution {
+            let d = &mut s.distribution;
+            ui.add(egui::Slider::new(&mut d.bounces, 1..=7).text("bounces"));
+            ui.add(egui::Slider::new(&mut d.paths_per_pass, 1..=64).text("paths per frame"));
+            ui.add(egui::Slider::new(&mut d.glossy_exponent, 1.0..=1000.0).logarithmic(true).text("glossy exponent"));
+            ui.checkbox(&mut d.all_glossy, "every surface glossy").on_hover_text("the MBVH RS paper's benchmark");
+            ui.add(egui::Slider::new(&mut d.aperture, 0.0..=1.0).text("lens radius"));
+            if let Some(paths) = paths {
+                ui.small(format!("{paths} paths per pixel so far"));
+            }
+        }
         let probe = *s;
         egui::ComboBox::from_label("method").selected_text(s.trace.method.name()).show_ui(ui, |ui| {
             for m in Method::ALL {
