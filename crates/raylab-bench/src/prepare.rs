@@ -1,4 +1,4 @@
-//! Loading a scene and building its kd-tree, with a spinner on a terminal.
+//! Loading a scene (with a progress bar) and building its kd-tree (with a spinner), on a terminal.
 
 use std::time::{Duration, Instant};
 
@@ -30,11 +30,16 @@ pub fn load_scene(source: &SceneSource) -> Result<(Scene, f64), String> {
     Ok((loaded.scene, seconds))
 }
 
-/// Loads the scene named by `source` with its warnings.
+/// Loads the scene named by `source` with its warnings, with a progress bar on a terminal.
 pub fn load_scene_verbose(source: &SceneSource) -> Result<(raylab_scene::Loaded, f64), String> {
     let t0 = Instant::now();
-    let loaded = with_spinner("loading scene", || raylab_scene::load(source)).map_err(|e| e.to_string())?;
-    Ok((loaded, t0.elapsed().as_secs_f64()))
+    let bar = ProgressBar::new(1000);
+    if let Ok(style) = ProgressStyle::with_template("loading scene [{bar:30}] {percent}% {elapsed}") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    let loaded = raylab_scene::load_with_progress(source, &|done| bar.set_position((done * 1000.0) as u64));
+    bar.finish_and_clear();
+    Ok((loaded.map_err(|e| e.to_string())?, t0.elapsed().as_secs_f64()))
 }
 
 /// Builds the kd-tree on a pool of `threads` threads.

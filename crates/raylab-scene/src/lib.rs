@@ -16,7 +16,7 @@ pub mod texture;
 
 pub use error::SceneError;
 pub use mesh::MeshBuilder;
-pub use source::{SceneSource, load};
+pub use source::{SceneSource, load, load_with_progress};
 
 /// A loaded scene and what the loader had to work around (missing textures, unreadable material libraries,
 /// dropped triangles), each warning naming the file.

@@ -26,6 +26,11 @@ impl SceneSource {
 /// Loads a scene with its warnings, adding the views and lights of a sidecar file ([`crate::sidecar`]). A file
 /// without lights or views gets none here; callers supply defaults.
 pub fn load(source: &SceneSource) -> Result<Loaded, SceneError> {
+    load_with_progress(source, &|_| {})
+}
+
+/// [`load`], reporting the share of the work done (0 to 1) to `progress` as it goes (for a progress bar).
+pub fn load_with_progress(source: &SceneSource, progress: &dyn Fn(f32)) -> Result<Loaded, SceneError> {
     match source {
         SceneSource::Builtin(name) => builtin::build(name, Detail::Full)
             .map(|scene| Loaded { scene, warnings: Vec::new() })
@@ -33,11 +38,12 @@ pub fn load(source: &SceneSource) -> Result<Loaded, SceneError> {
         SceneSource::File(path) => {
             let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
             let mut loaded = match ext.as_deref() {
-                Some("obj") => crate::obj::load(path),
+                Some("obj") => crate::obj::load_with_progress(path, progress),
                 Some("gltf" | "glb") => crate::gltf_model::load(path),
                 _ => Err(SceneError::Format { path: path.clone() }),
             }?;
             crate::sidecar::apply(path, &mut loaded.scene, &mut loaded.warnings);
+            progress(1.0);
             Ok(loaded)
         }
     }

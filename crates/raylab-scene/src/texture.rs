@@ -100,11 +100,18 @@ impl TextureSet {
     }
 }
 
-/// An image reader over `bytes` with the format guessed from its content and the size limits set.
+/// An image reader over `bytes` with the format guessed from its content (or, for TGA, which has no
+/// signature, from `name`'s extension) and the size limits set.
 fn reader<'a>(name: &str, bytes: &'a [u8]) -> Result<image::ImageReader<std::io::Cursor<&'a [u8]>>, String> {
     let mut r = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| format!("cannot read texture {name}: {e}"))?;
+    // TGA has no signature: fall back on the name's extension.
+    if r.format().is_none()
+        && let Ok(format) = image::ImageFormat::from_path(name)
+    {
+        r.set_format(format);
+    }
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_DIMENSION);
     limits.max_image_height = Some(MAX_DIMENSION);
@@ -155,6 +162,25 @@ mod tests {
         assert!((c.texels[0].x - 0.5).abs() < 0.01, "sRGB 188 is about linear 0.5: {}", c.texels[0].x);
         assert!((n.texels[1].z - 1.0).abs() < 1e-6 && (n.texels[1].x - 128.0 / 255.0).abs() < 1e-6);
         assert!(set.warnings.is_empty());
+    }
+
+    #[test]
+    fn jpeg_tga_and_bmp_decode_too() {
+        for (format, name) in [
+            (image::ImageFormat::Jpeg, "white.jpg"),
+            (image::ImageFormat::Tga, "white.tga"),
+            (image::ImageFormat::Bmp, "white.bmp"),
+        ] {
+            let img = image::RgbImage::from_pixel(4, 2, image::Rgb([255, 255, 255]));
+            let mut bytes = Vec::new();
+            img.write_to(&mut std::io::Cursor::new(&mut bytes), format).unwrap();
+            let mut set = TextureSet::default();
+            let id = set.bytes(name, &bytes, TextureUse::Color);
+            let t = &set.textures[id as usize];
+            assert_eq!((t.width, t.height), (4, 2), "{format:?}");
+            assert!(t.texels.iter().all(|v| v.min_element() > 0.95), "{format:?}");
+            assert!(set.warnings.is_empty(), "{format:?}: {:?}", set.warnings);
+        }
     }
 
     #[test]

@@ -38,7 +38,9 @@ pub struct LoadedScene {
 pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Result<LoadedScene, String> {
     let t0 = Instant::now();
     stage("loading scene");
-    let raylab_scene::Loaded { scene, warnings } = raylab_scene::load(&args.source()).map_err(|e| e.to_string())?;
+    let progress = |done: f32| stage(&format!("loading scene {:.0}%", done * 100.0));
+    let raylab_scene::Loaded { scene, warnings } =
+        raylab_scene::load_with_progress(&args.source(), &progress).map_err(|e| e.to_string())?;
     let (camera, light) = args.camera_and_light(&scene)?;
     stage("building kd-tree");
     let tree = KdTree::build(&scene, params).map_err(|e| format!("{}: {e}", args.scene))?;

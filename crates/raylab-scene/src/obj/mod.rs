@@ -22,12 +22,18 @@ use crate::{Loaded, SceneError};
 
 /// Loads the OBJ file at `path` with its materials and textures.
 pub fn load(path: &Path) -> Result<Loaded, SceneError> {
+    load_with_progress(path, &|_| {})
+}
+
+/// [`load`], reporting the share of the work done (0 to 1) to `progress`: the line check is the first 40%,
+/// tobj's parse the next 40%, building the scene the rest.
+pub fn load_with_progress(path: &Path, progress: &dyn Fn(f32)) -> Result<Loaded, SceneError> {
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
     let text = std::str::from_utf8(&bytes).map_err(|e| {
         let line = bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
         SceneError::Parse { path: path.to_path_buf(), line, message: "not UTF-8 text".into() }
     })?;
-    let faces = check_lines(text, path)?;
+    let faces = check_lines(text, path, &|done| progress(0.4 * done))?;
     if faces == 0 {
         return Err(SceneError::Empty { path: path.to_path_buf(), detail: "no face records".into() });
     }
@@ -66,6 +72,7 @@ pub fn load(path: &Path) -> Result<Loaded, SceneError> {
     if let Some(e) = refused.into_inner() {
         return Err(e);
     }
+    progress(0.8);
     warnings.extend(mtl_warnings.into_inner());
     let mtl_dir = mtl_files.borrow().first().and_then(|f| f.parent().map(Path::to_path_buf)).unwrap_or(dir.clone());
 
@@ -139,11 +146,16 @@ fn push_uvs(out: &mut Vec<Vec2>, texcoords: &[f32], n: usize) {
 
 /// Checks every record tobj will read and returns the number of faces; the first problem is an error naming
 /// the file and line.
-fn check_lines(text: &str, path: &Path) -> Result<usize, SceneError> {
+fn check_lines(text: &str, path: &Path, progress: &dyn Fn(f32)) -> Result<usize, SceneError> {
     let err = |line: usize, message: String| SceneError::Parse { path: path.to_path_buf(), line, message };
     let (mut v, mut vt, mut vn, mut faces) = (0i64, 0i64, 0i64, 0usize);
+    let (mut read, total) = (0usize, text.len().max(1));
     for (n, line) in text.lines().enumerate() {
         let no = n + 1;
+        read += line.len() + 1;
+        if n % 65_536 == 0 {
+            progress(read as f32 / total as f32);
+        }
         let mut it = line.split_whitespace();
         let Some(tag) = it.next() else { continue };
         let numbers = |it: std::str::SplitWhitespace, want: usize, what: &str| -> Result<(), SceneError> {
