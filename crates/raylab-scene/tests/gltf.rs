@@ -267,6 +267,9 @@ fn bad_and_hostile_files_give_specific_errors() {
             "no triangle primitives",
         ),
     ];
+    let whole = packed(json!({}));
+    let cases: Vec<(&str, Vec<u8>, &str)> =
+        cases.into_iter().chain([("cut.glb", whole[..whole.len() / 2].to_vec(), "cut.glb")]).collect();
     for (name, bytes, want) in &cases {
         let e = err(dir.path(), name, bytes);
         assert!(e.contains(want), "{name}: '{e}' should contain '{want}'");
