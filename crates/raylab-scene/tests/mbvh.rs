@@ -206,3 +206,24 @@ fn ray_streams_match_brute_force() {
         }
     }
 }
+
+/// Triangles spaced ever wider along a line make SAH split one off at a time: a lopsided tree, as deep as the
+/// build allows, still traced right.
+#[test]
+fn a_pathologically_deep_tree_still_traces_right() {
+    let mut b = SceneBuilder::new();
+    for k in 0..70 {
+        let x = 1.6f32.powi(k);
+        let base = b.positions.len() as u32;
+        b.positions.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)]);
+        b.triangles.push(Triangle { v: [base, base + 1, base + 2], material: 0 });
+    }
+    let scene = b.build();
+    let m = Mbvh::build(&scene);
+    assert!(m.stats().depth >= 10, "depth {}", m.stats().depth);
+    let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let mut rays = adversarial_rays(&scene, &kd, 100, 4);
+    rays.extend((0..200).map(|k| Ray::new(Vec3::new(-1.0, 0.2 + k as f32 * 1e-3, 0.3), Vec3::new(1.0, 0.0, 0.0))));
+    rays.extend((0..50).map(|k| Ray::new(Vec3::new(2e15, 0.25, 0.25), Vec3::new(-1.0, 1e-4 * k as f32, 0.0))));
+    check_hits(&scene, &m, &rays, "deep");
+}

@@ -27,6 +27,8 @@ pub struct Mbvh {
     bounds: Aabb,
     build_time: Duration,
     binary_nodes: usize,
+    /// Levels of 4-wide nodes (the root is 1), which sizes the traversal stack.
+    depth: usize,
     /// SIMD backend of the box tests.
     pub backend: Backend,
 }
@@ -60,6 +62,7 @@ impl Mbvh {
         let boxes: Vec<Aabb> = tris.as_slice().iter().map(|t| Aabb::from_points(*t)).collect();
         let centroids: Vec<Vec3> = boxes.iter().map(Aabb::center).collect();
         let built = build::build(&boxes, &centroids);
+        let depth = depth_of(&built.nodes);
         Self {
             nodes: built.nodes,
             tri_ids: built.tri_ids,
@@ -67,6 +70,7 @@ impl Mbvh {
             tris,
             build_time: start.elapsed(),
             binary_nodes: built.binary_nodes,
+            depth,
             backend: Backend::detect(),
         }
     }
@@ -110,13 +114,6 @@ impl Mbvh {
                 }
             }
         }
-        let mut depth = 0;
-        let mut stack = vec![(0usize, 1usize)];
-        while let Some((i, d)) = stack.pop() {
-            depth = depth.max(d);
-            let n = &self.nodes[i];
-            stack.extend((0..4).filter(|&k| !n.is_empty(k) && !n.is_leaf(k)).map(|k| (n.child[k] as usize, d + 1)));
-        }
         MbvhStats {
             build_seconds: self.build_time.as_secs_f64(),
             nodes: self.nodes.len(),
@@ -124,8 +121,20 @@ impl Mbvh {
             leaves,
             lane_fill_percent: 100.0 * used as f64 / (4 * self.nodes.len()).max(1) as f64,
             avg_tris_per_leaf: tris as f64 / leaves.max(1) as f64,
-            depth,
+            depth: self.depth,
             bytes: self.nodes.len() * std::mem::size_of::<MbvhNode>() + self.tri_ids.len() * 4,
         }
     }
+}
+
+/// Levels of 4-wide nodes below and including the root.
+fn depth_of(nodes: &[MbvhNode]) -> usize {
+    let mut depth = 0;
+    let mut stack = vec![(0usize, 1usize)];
+    while let Some((i, d)) = stack.pop() {
+        depth = depth.max(d);
+        let n = &nodes[i];
+        stack.extend((0..4).filter(|&k| !n.is_empty(k) && !n.is_leaf(k)).map(|k| (n.child[k] as usize, d + 1)));
+    }
+    depth
 }

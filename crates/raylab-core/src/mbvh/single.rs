@@ -59,9 +59,14 @@ struct Entry {
     near: f32,
 }
 
-/// Stack entries: three per level, for the deepest tree the build can make (48 SAH levels, then halving:
-/// under 81 levels).
-const STACK: usize = 256;
+/// Stack entries for the deepest tree the build can make (48 SAH levels, then halving: under 81 levels, three
+/// entries each).
+const DEEP_STACK: usize = 256;
+/// Stack entries for trees at most [`SHALLOW_DEPTH`] levels deep (all but pathological ones): a smaller array
+/// costs less to set up per ray.
+const SHALLOW_STACK: usize = 64;
+/// Deepest tree the shallow stack serves (three entries a level, plus the root's four).
+const SHALLOW_DEPTH: usize = (SHALLOW_STACK - 4) / 3;
 
 impl Mbvh {
     /// The closest hit along `ray` in `(tmin, tmax]`.
@@ -87,7 +92,7 @@ impl Mbvh {
         let mut best: Option<Hit> = None;
         let mut best_t = ray.tmax;
         let mut tests = 0u64;
-        self.walk::<V>(ray, stats, |ids, limit| {
+        let mut leaf = |ids: &[u32], limit: &mut f32| {
             for &id in ids {
                 tests += 1;
                 if let Some(h) = shear.intersect(self.tris.get(id), ray.tmin, best_t) {
@@ -97,7 +102,8 @@ impl Mbvh {
             }
             *limit = best_t;
             false
-        });
+        };
+        self.walk_sized::<V>(ray, stats, &mut leaf);
         stats.isect_tests += tests;
         best
     }
@@ -119,7 +125,7 @@ impl Mbvh {
         let shear = RayShear::new(ray);
         let mut blocker = None;
         let mut tests = 0u64;
-        self.walk::<V>(ray, stats, |ids, _| {
+        let mut leaf = |ids: &[u32], _: &mut f32| {
             for &id in ids {
                 tests += 1;
                 if shear.intersect(self.tris.get(id), ray.tmin, ray.tmax).is_some() {
@@ -128,15 +134,36 @@ impl Mbvh {
                 }
             }
             false
-        });
+        };
+        self.walk_sized::<V>(ray, stats, &mut leaf);
         stats.isect_tests += tests;
         blocker
+    }
+
+    /// [`Mbvh::walk`] with the smallest stack this tree needs.
+    #[inline(always)]
+    fn walk_sized<V: Vf32>(
+        &self,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+        leaf: &mut impl FnMut(&[u32], &mut f32) -> bool,
+    ) {
+        if self.depth <= SHALLOW_DEPTH {
+            self.walk::<V, SHALLOW_STACK>(ray, stats, leaf);
+        } else {
+            self.walk::<V, DEEP_STACK>(ray, stats, leaf);
+        }
     }
 
     /// Walks the leaves `ray` reaches, nearest child first; `leaf(ids, limit)` tests a leaf's triangles,
     /// may lower `limit` (the farthest distance still of interest), and returns true to stop.
     #[inline(always)]
-    fn walk<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats, mut leaf: impl FnMut(&[u32], &mut f32) -> bool) {
+    fn walk<V: Vf32, const STACK: usize>(
+        &self,
+        ray: &Ray,
+        stats: &mut TraversalStats,
+        leaf: &mut impl FnMut(&[u32], &mut f32) -> bool,
+    ) {
         stats.rays += 1;
         stats.packets += 1;
         if self.tri_ids.is_empty() || !ray.is_valid() {
@@ -202,5 +229,41 @@ impl Mbvh {
         stats.nodes += nodes;
         stats.leaves += leaves;
         stats.box_tests += boxes;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::scene::{SceneBuilder, Triangle};
+
+    /// The deep-tree stack walks exactly like the shallow one.
+    #[test]
+    fn both_stack_sizes_walk_alike() {
+        let mut b = SceneBuilder::new();
+        for k in 0..300u32 {
+            let o = Vec3::new((k % 17) as f32, (k / 17) as f32, (k % 5) as f32 * 0.3);
+            let base = b.positions.len() as u32;
+            b.positions.extend([o, o + Vec3::X * 0.8, o + Vec3::Y * 0.8]);
+            b.triangles.push(Triangle { v: [base, base + 1, base + 2], material: 0 });
+        }
+        let m = Mbvh::build(&b.build());
+        for k in 0..200 {
+            let a = k as f32 * 0.37;
+            let ray = Ray::new(Vec3::new(a.sin() * 3.0 + 8.0, a.cos() * 4.0 + 9.0, 5.0), Vec3::new(0.1, -0.05, -1.0));
+            let mut leaves = (Vec::new(), Vec::new());
+            let mut s = TraversalStats::default();
+            m.walk::<raylab_simd::scalar::F32x4, SHALLOW_STACK>(&ray, &mut s, &mut |ids: &[u32], _: &mut f32| {
+                leaves.0.push(ids[0]);
+                false
+            });
+            m.walk::<raylab_simd::scalar::F32x4, DEEP_STACK>(&ray, &mut s, &mut |ids: &[u32], _: &mut f32| {
+                leaves.1.push(ids[0]);
+                false
+            });
+            assert_eq!(leaves.0, leaves.1);
+        }
     }
 }
