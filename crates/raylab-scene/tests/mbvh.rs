@@ -165,8 +165,8 @@ fn every_triangle_is_in_exactly_one_leaf_and_lanes_are_well_formed() {
     }
 }
 
-/// MBVH RS (ray streams) against brute force: incoherent groups of every size from 2^4 to 2^12, with and
-/// without the ordering heuristic, closest hits and occlusion.
+/// MBVH RS (ray streams) against brute force: incoherent and adversarial rays in groups of 2^4 to 2^12, with
+/// and without the ordering heuristic, closest hits and occlusion.
 #[test]
 fn ray_streams_match_brute_force() {
     use raylab_core::method::Method;
@@ -176,7 +176,11 @@ fn ray_streams_match_brute_force() {
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
         let m = Mbvh::build(&scene);
         let bf = BruteForce::new(&scene);
-        let rays: Vec<Option<Ray>> = incoherent(&scene, 4096, 23).into_iter().map(Some).collect();
+        // Incoherent rays, then the adversarial set: zero direction components of both signs, rays in split
+        // planes and along triangle planes, through vertices and edges, short segments.
+        let mut rays: Vec<Option<Ray>> = incoherent(&scene, 4096, 23).into_iter().map(Some).collect();
+        rays.extend(adversarial_rays(&scene, &kd, 200, 29).into_iter().map(Some));
+        let total = rays.len() as u64;
         for (group, ordered) in [(16, true), (256, true), (256, false), (4096, true)] {
             let opts = TraceOptions { method: Method::MbvhRs, stream_order: ordered, ..TraceOptions::default() };
             let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
@@ -199,7 +203,7 @@ fn ray_streams_match_brute_force() {
                     assert_eq!(*b, bf.occluded(&r, &mut TraversalStats::default()), "{name} group {group}: {r:?}");
                 }
             }
-            assert_eq!(s.rays, 2 * 4096);
+            assert_eq!(s.rays, 2 * total);
             assert!(s.box_tests > 0 && s.leaf_rays > 0);
             let u = s.leaf_utilisation();
             assert!(u[0] >= u[1] && u[1] >= u[2] && u[0] <= 100.0, "{u:?}");

@@ -265,10 +265,7 @@ fn distribution_pass(p: &mut Progressive) -> Rendered {
     let tracer = Tracer::new(&s.tree, None, job.settings.trace).with_mbvh(&s.mbvh);
     let mut camera = job.camera;
     camera.aperture = job.settings.distribution.aperture;
-    let mut light = job.light;
-    if light.radius <= 0.0 {
-        light.radius = 0.02 * s.scene.bounds().diagonal();
-    }
+    let light = job.light.soft();
     let t0 = Instant::now();
     let bounces = render_pass(&s.scene, &tracer, &camera, light, &settings, p.passes, &mut p.acc);
     p.passes += 1;

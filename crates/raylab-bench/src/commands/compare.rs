@@ -7,6 +7,7 @@ use std::process::Command;
 
 use clap::Args;
 use raylab_core::kdtree::KdTree;
+use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
 use raylab_core::trace::{TraceOptions, Tracer};
@@ -48,6 +49,10 @@ pub struct CompareArgs {
     /// Coherent methods to measure beside Embree's packet and stream APIs (primary and shadow rays).
     #[arg(long, value_delimiter = ',', default_value = "packet,frustum,mft,cone,mft-cone")]
     methods: Vec<Method>,
+    /// MBVH methods to measure on the diffuse (incoherent) rays beside Embree's `rtcIntersect1` and
+    /// `rtcIntersect1M` (mbvh-rs traces each 16x16 tile as one group of 256 rays).
+    #[arg(long, value_delimiter = ',', default_value = "mbvh,mbvh-rs")]
+    incoherent: Vec<Method>,
     /// Tile sizes for the frustum methods.
     #[arg(long, value_delimiter = ',', default_value = "4,8,16", value_parser = in_range(2, 256))]
     tiles: Vec<u64>,
@@ -174,6 +179,37 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         }
     }
 
+    // Incoherent rays: the MBVH methods on the diffuse rays (MBVH RS paper).
+    let mut mbvh_builds = Vec::new();
+    let mut incoherent: Vec<(Method, TraceReport)> = Vec::new();
+    let mbvh_methods: Vec<Method> = a.incoherent.iter().copied().filter(|m| m.uses_mbvh()).collect();
+    if !mbvh_methods.is_empty() {
+        let mut mbvh = None;
+        for &t in &a.threads {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(t as usize).build().map_err(|e| e.to_string())?;
+            let mut times = Vec::new();
+            for _ in 0..a.builds {
+                let built = pool.install(|| Mbvh::build(&scene));
+                times.push(built.build_time().as_secs_f64());
+                mbvh = Some(built);
+            }
+            times.sort_by(f64::total_cmp);
+            mbvh_builds.push((t, times[times.len() / 2]));
+        }
+        let mbvh = mbvh.ok_or("--threads: no thread count given")?;
+        let workload = wb.build(RayKind::Diffuse);
+        for &method in &mbvh_methods {
+            for &t in &a.threads {
+                let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() }).with_mbvh(&mbvh);
+                let (report, results) =
+                    measure(&tracer, &workload, HARNESS_TILE, t as usize, a.warmup as usize, a.reps as usize)?;
+                validate(&reference, &workload, &results, 256)
+                    .map_err(|m| format!("validation failed ({method}): {m}"))?;
+                incoherent.push((method, report));
+            }
+        }
+    }
+
     let mut md = String::new();
     let cmd: Vec<String> = std::env::args().collect();
     let _ = writeln!(md, "Machine and build: {}.", env.line());
@@ -268,6 +304,46 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                 bval,
                 ratio,
                 check
+            );
+        }
+    }
+    if !incoherent.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nIncoherent rays: the MBVH methods on the diffuse rays against Embree's single-ray and stream APIs \
+             (per ray: 4-box SIMD tests, node fetches, triangle tests; MBVH RS groups are 16x16 tiles, 256 rays). \
+             MBVH builds (median of {}): {}.\n",
+            a.builds,
+            mbvh_builds.iter().map(|(t, s)| format!("{s:.3} s on {t} thread(s)")).collect::<Vec<_>>().join(", ")
+        );
+        let _ = writeln!(
+            md,
+            "| method | threads | Mrays/s (min-max) | Embree rtcIntersect1 | raylab / Embree | Embree rtcIntersect1M | raylab / Embree | box tests | fetches | tests | check |"
+        );
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+        for (method, r) in &incoherent {
+            let embree_of = |kind: &str| {
+                embree
+                    .rows
+                    .iter()
+                    .find(|e| e.kind == kind && e.threads == r.threads as u64)
+                    .map_or(("n/a".to_string(), "n/a".to_string()), |e| {
+                        (format!("{:.2}", e.median), format!("{:.2}x", r.mrays_median / e.median))
+                    })
+            };
+            let ((e1, r1), (em, rm)) = (embree_of("diffuse_1"), embree_of("diffuse_1M"));
+            let _ = writeln!(
+                md,
+                "| {method} | {} | {:.2} ({:.2}-{:.2}) | {e1} | {r1} | {em} | {rm} | {:.2} | {:.2} | {:.2} | {} hits, {:.1} |",
+                r.threads,
+                r.mrays_median,
+                r.mrays_min,
+                r.mrays_max,
+                r.box_tests_per_ray,
+                r.nodes_per_ray,
+                r.isects_per_ray,
+                r.hits,
+                r.sum_t
             );
         }
     }

@@ -67,11 +67,9 @@ pub struct DistributionArgs {
 pub fn run(a: &DistributionArgs) -> Result<(), String> {
     let env = Environment::detect();
     let (scene, _) = load_scene(&a.scene.source())?;
-    let (mut camera, mut light) = a.scene.camera_and_light(&scene)?;
+    let (mut camera, light) = a.scene.camera_and_light(&scene)?;
     camera.aperture = a.aperture;
-    if light.radius <= 0.0 {
-        light.radius = 1.0;
-    }
+    let light = light.soft();
     let tree = build_tree(&scene, &a.kd.params()?, a.threads as usize)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string())?;
     let mbvh = with_spinner("building MBVH", || pool.install(|| Mbvh::build(&scene)));

@@ -45,12 +45,6 @@ pub struct Subject<'a> {
     pub light: PointLight,
 }
 
-/// Light radius of the soft techniques where the table does not fix one: the scene's own, or 1 (the thesis's
-/// Sponza light) for a point light.
-fn soft_radius(light: &PointLight) -> f32 {
-    if light.radius > 0.0 { light.radius } else { 1.0 }
-}
-
 impl ShadingRun<'_> {
     fn settings(&self, shadows: Shadows, max_depth: u32, size: (u32, u32)) -> RenderSettings {
         RenderSettings { width: size.0, height: size.1, tile: self.tile, shadows, max_depth, ..Default::default() }
@@ -95,7 +89,7 @@ impl ShadingRun<'_> {
         let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|");
         for s in subjects {
             let tracer = Self::tracer(s);
-            let light = PointLight { radius: soft_radius(&s.light), ..s.light };
+            let light = s.light.soft();
             let r = light.radius;
             let cell = |shadows| self.timed(s, &tracer, light, shadows, 0);
             let none = cell(Shadows::None);
@@ -186,7 +180,7 @@ impl ShadingRun<'_> {
         let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|");
         for s in subjects {
             let tracer = Self::tracer(s);
-            let light = PointLight { radius: soft_radius(&s.light), ..s.light };
+            let light = s.light.soft();
             let r = light.radius;
             let shot = |shadows: Shadows| -> Frame {
                 self.pool.install(|| render(s.scene, &tracer, &s.camera, light, &self.settings(shadows, 0, (w, h))))

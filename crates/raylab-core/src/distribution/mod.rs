@@ -182,16 +182,20 @@ impl Pass<'_> {
             self.tracer.intersect_tile(&rays, lw, lh, &mut hits, &mut b.stats);
             b.seconds = t0.elapsed().as_secs_f64();
             b.rays = rays.iter().filter(|r| r.is_some()).count() as u64;
+            let surfaces: Vec<Option<Surface>> = rays
+                .iter()
+                .zip(&hits)
+                .map(|(r, h)| match (r, h) {
+                    (Some(r), Some(h)) => Some(Surface::at(self.scene, r, h)),
+                    _ => None,
+                })
+                .collect();
             // Direct light: one shadow ray per hit to a random point on the light's disc.
             for k in 0..n {
-                shadow[k] = match (&rays[k], &hits[k]) {
-                    (Some(r), Some(hit)) => {
-                        let s = Surface::at(self.scene, r, hit);
-                        let target = self.light_point(s.point, &mut rngs[k]);
-                        crate::render::shade::shadow_ray(&s, self.light.position, target, self.epsilon)
-                    }
-                    _ => None,
-                };
+                shadow[k] = surfaces[k].as_ref().and_then(|s| {
+                    let target = self.light_point(s.point, &mut rngs[k]);
+                    crate::render::shade::shadow_ray(s, self.light.position, target, self.epsilon)
+                });
             }
             let t1 = Instant::now();
             blocked.iter_mut().for_each(|x| *x = false);
@@ -203,11 +207,10 @@ impl Pass<'_> {
             b.shadow_rays = shadow.iter().filter(|r| r.is_some()).count() as u64;
             // Shade and continue the paths.
             for k in 0..n {
-                let (Some(r), Some(hit)) = (rays[k], hits[k]) else {
+                let (Some(r), Some(s)) = (rays[k], &surfaces[k]) else {
                     rays[k] = None;
                     continue;
                 };
-                let s = Surface::at(self.scene, &r, &hit);
                 let visible = if shadow[k].is_some() && !blocked[k] { 1.0 } else { 0.0 };
                 let mut local = s.local(r.dir, &self.light, visible);
                 if bounce > 0 {
@@ -216,7 +219,7 @@ impl Pass<'_> {
                 }
                 radiance[k] += throughput[k] * local;
                 rays[k] = (bounce < self.settings.bounces)
-                    .then(|| self.scatter(&s, &r, &mut rngs[k], &mut throughput[k]))
+                    .then(|| self.scatter(s, &r, &mut rngs[k], &mut throughput[k]))
                     .flatten();
             }
             bounces.push(b);

@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec3};
 
 pub use crate::shadow::concentric_disc as disc;
+use crate::shadow::samples::hash;
 
 /// A small generator seeded from a pixel, a sample and a pass.
 pub struct Rng(u32);
@@ -19,12 +20,6 @@ impl Rng {
         self.0 = hash(self.0.wrapping_add(0x6D2B_79F5));
         (self.0 >> 8) as f32 / (1u32 << 24) as f32
     }
-}
-
-fn hash(x: u32) -> u32 {
-    let s = x.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    let w = ((s >> ((s >> 28) + 4)) ^ s).wrapping_mul(277_803_737);
-    (w >> 22) ^ w
 }
 
 /// A direction about unit `axis` with density proportional to `cos^n` of the angle to it (`n = 1`: the

@@ -114,14 +114,15 @@ impl Mbvh {
             current.extend(stack.drain(start..));
             if task.tris > 0 {
                 leaves += 1;
-                let live: Vec<u32> = current.iter().copied().filter(|&i| !slots[i as usize].blocked).collect();
-                let c = live.len() as u64;
+                // Shadow rays blocked since they were queued leave the stream here.
+                current.retain(|&i| !slots[i as usize].blocked);
+                let c = current.len() as u64;
                 leaf_rays += c;
                 slots4 += c.div_ceil(4) * 4;
                 slots8 += c.div_ceil(8) * 8;
                 slots16 += c.div_ceil(16) * 16;
                 let tri_ids = &self.tri_ids[task.child as usize..(task.child + task.tris) as usize];
-                for group in live.chunks(4) {
+                for group in current.chunks(4) {
                     tests += self.leaf_packet(slots, group, tri_ids, shadow);
                 }
                 continue;

@@ -29,6 +29,15 @@ impl PointLight {
         Self { position, color: Vec3::ONE, constant: 1.0, linear: 0.0, quadratic: 0.0, radius: 0.0 }
     }
 
+    /// Radius soft techniques give a point light (the thesis's Sponza light, thesis Table 4.6).
+    pub const DEFAULT_SOFT_RADIUS: f32 = 1.0;
+
+    /// This light, with [`Self::DEFAULT_SOFT_RADIUS`] if it is a point, for techniques that need a sphere to
+    /// sample or approximate.
+    pub fn soft(self) -> Self {
+        if self.radius > 0.0 { self } else { Self { radius: Self::DEFAULT_SOFT_RADIUS, ..self } }
+    }
+
     /// The attenuation factor at distance `d`, clamped to at most 1.
     pub fn attenuation(&self, d: f32) -> f32 {
         let denom = self.constant + self.linear * d + self.quadratic * d * d;

@@ -6,7 +6,7 @@
 
 mod cache;
 mod edge_width;
-mod samples;
+pub(crate) mod samples;
 
 pub use cache::ShadowCache;
 pub use edge_width::{Crossing, EdgeWidth};

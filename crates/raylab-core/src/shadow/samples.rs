@@ -71,7 +71,8 @@ fn jitter(seed: u32, k: u32) -> (f32, f32) {
     ((h >> 8) as f32 / (1u32 << 24) as f32, (g >> 8) as f32 / (1u32 << 24) as f32)
 }
 
-fn hash(x: u32) -> u32 {
+/// A PCG-style integer hash (also the distribution tracer's random numbers).
+pub(crate) fn hash(x: u32) -> u32 {
     let s = x.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
     let w = ((s >> ((s >> 28) + 4)) ^ s).wrapping_mul(277_803_737);
     (w >> 22) ^ w
