@@ -198,12 +198,12 @@ impl KdArgs {
 /// Traversal-method flags shared by `render` and `trace`.
 #[derive(Args, Clone, Debug)]
 pub struct MethodArgs {
-    /// Traversal method: mono, packet, frustum, mft, cone, mft-cone, mbvh, mbvh-rs or reference.
+    /// Traversal method: mono, packet, frustum, mft, cone, mft-cone, mbvh, mbvh-rs, dacrt or reference.
     #[arg(long, default_value = "mono")]
     pub method: raylab_core::method::Method,
     /// Tile edge in pixels: the frustum size of frustum methods, the ray group of mbvh-rs (16: 2^8 rays), the
-    /// unit threads take for all.
-    #[arg(long, default_value_t = 16, value_parser = in_range(1, 256))]
+    /// ray set of dacrt, the unit threads take for all.
+    #[arg(long, default_value_t = 16, value_parser = in_range(1, 4096))]
     pub tile: u64,
     /// Turn packet/leaf culling off (frustum methods).
     #[arg(long)]
@@ -218,6 +218,15 @@ pub struct MethodArgs {
     /// Walk MBVH RS child tasks in lane order instead of by accumulated hit length (to measure the ordering).
     #[arg(long)]
     pub no_stream_order: bool,
+    /// DACRT: a node with at most this many rays is tested naively.
+    #[arg(long, default_value_t = 8, value_parser = in_range(1, raylab_core::dacrt::DacrtParams::MAX_LEAF as u64))]
+    pub dacrt_leaf_rays: u64,
+    /// DACRT: a node with at most this many triangles is tested naively.
+    #[arg(long, default_value_t = 8, value_parser = in_range(1, raylab_core::dacrt::DacrtParams::MAX_LEAF as u64))]
+    pub dacrt_leaf_tris: u64,
+    /// DACRT: how triangles are divided, sah (16 bins) or median.
+    #[arg(long, default_value = "sah")]
+    pub dacrt_split: raylab_core::dacrt::SplitRule,
 }
 
 /// Shadow-technique and recursion flags shared by `render`, `compare` and the viewer (thesis chapter 5,
@@ -259,6 +268,11 @@ impl MethodArgs {
             backend: self.backend.unwrap_or_else(raylab_simd::Backend::detect),
             shadow_spread_limit: self.shadow_spread_limit,
             stream_order: !self.no_stream_order,
+            dacrt: raylab_core::dacrt::DacrtParams {
+                leaf_rays: self.dacrt_leaf_rays as usize,
+                leaf_tris: self.dacrt_leaf_tris as usize,
+                split: self.dacrt_split,
+            },
         }
     }
 }

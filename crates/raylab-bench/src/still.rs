@@ -4,6 +4,7 @@
 
 use std::time::Instant;
 
+use raylab_core::dacrt::Dacrt;
 use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
@@ -47,10 +48,14 @@ pub fn render_still(
     let t0 = Instant::now();
     let reference = (options.method == Method::Reference).then(|| BruteForce::new(&loaded));
     let mbvh = options.method.uses_mbvh().then(|| pool.install(|| Mbvh::build(&loaded)));
+    let dacrt = options.method.uses_dacrt().then(|| Dacrt::new(&loaded));
     let frame = {
         let mut tracer = Tracer::new(&tree, reference.as_ref(), options);
         if let Some(m) = &mbvh {
             tracer = tracer.with_mbvh(m);
+        }
+        if let Some(d) = &dacrt {
+            tracer = tracer.with_dacrt(d);
         }
         pool.install(|| render(&loaded, &tracer, &camera, light, settings))
     };

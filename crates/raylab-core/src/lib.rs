@@ -9,6 +9,7 @@
 //! This crate knows nothing about files, windows or GPUs.
 
 pub mod aabb;
+pub mod dacrt;
 pub mod distribution;
 pub mod kdtree;
 pub mod mbvh;

@@ -5,6 +5,7 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use crate::dacrt::{Dacrt, DacrtParams};
 use crate::kdtree::KdTree;
 use crate::mbvh::Mbvh;
 use crate::ray::{Hit, Ray};
@@ -33,13 +34,16 @@ pub enum Method {
     /// MBVH ray stream tracing: each tile is one group of rays walked breadth-first (MBVH RS paper,
     /// Algorithm 1); the tile size sets the group size (16x16 = 2^8).
     MbvhRs,
+    /// Divide-and-conquer ray tracing with no stored structure (seed 003; Mora 2011, Afra 2012): each tile's
+    /// rays are traced as one set against the scene's triangles, so larger tiles amortise more.
+    Dacrt,
     /// Every ray against every triangle; for testing only.
     Reference,
 }
 
 impl Method {
     /// All methods, in the order menus list them.
-    pub const ALL: [Method; 9] = [
+    pub const ALL: [Method; 10] = [
         Method::Mono,
         Method::Packet,
         Method::Frustum,
@@ -48,6 +52,7 @@ impl Method {
         Method::MftCone,
         Method::Mbvh,
         Method::MbvhRs,
+        Method::Dacrt,
         Method::Reference,
     ];
 
@@ -62,6 +67,7 @@ impl Method {
             Method::MftCone => "mft-cone",
             Method::Mbvh => "mbvh",
             Method::MbvhRs => "mbvh-rs",
+            Method::Dacrt => "dacrt",
             Method::Reference => "reference",
         }
     }
@@ -71,15 +77,37 @@ impl Method {
         matches!(self, Method::Packet | Method::Frustum | Method::Mft | Method::Cone | Method::MftCone)
     }
 
-    /// True for the methods whose cost depends on the tile size (frustums, and ray streams, whose group is
-    /// the tile).
+    /// True for the methods whose cost depends on the tile size (frustums, ray streams, whose group is the
+    /// tile, and DACRT, whose ray set is).
     pub fn uses_tiles(self) -> bool {
-        matches!(self, Method::Frustum | Method::Mft | Method::Cone | Method::MftCone | Method::MbvhRs)
+        matches!(self, Method::Frustum | Method::Mft | Method::Cone | Method::MftCone | Method::MbvhRs | Method::Dacrt)
     }
 
     /// True for the methods that trace with the MBVH.
     pub fn uses_mbvh(self) -> bool {
         matches!(self, Method::Mbvh | Method::MbvhRs)
+    }
+}
+
+impl Method {
+    /// Fewest rays the renderers hand DACRT as one set: below this its per-set cost (dividing the triangles
+    /// near the top of the recursion, whatever the number of rays) outweighs the rays' own work.
+    pub const DACRT_MIN_SET: u32 = 16384;
+
+    /// True for divide-and-conquer ray tracing, which needs a [`Dacrt`] instead of a stored structure.
+    pub fn uses_dacrt(self) -> bool {
+        self == Method::Dacrt
+    }
+
+    /// The tile edge the renderers use for a requested `tile` with `rays_per_pixel` rays per pixel: the
+    /// request, except for DACRT, whose tiles grow until they hold [`Method::DACRT_MIN_SET`] rays.
+    pub fn tile_edge(self, tile: u32, rays_per_pixel: u32) -> u32 {
+        let tile = tile.max(1);
+        if self != Method::Dacrt {
+            return tile;
+        }
+        let min = (Self::DACRT_MIN_SET as f64 / rays_per_pixel.max(1) as f64).sqrt().ceil() as u32;
+        tile.max(min)
     }
 }
 
@@ -131,5 +159,20 @@ impl Intersector for BruteForce {
     }
     fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
         BruteForce::occluded(self, ray, stats)
+    }
+}
+
+/// One ray traced as a set of one with the default parameters: correct, but DACRT's cost is amortised over large sets
+/// ([`Dacrt::intersect`]); this serves the shared per-ray tests.
+impl Intersector for Dacrt {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        let mut out = [None];
+        Dacrt::intersect(self, &DacrtParams::default(), &[Some(*ray)], &mut out, stats);
+        out[0]
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        let mut out = [false];
+        Dacrt::occluded(self, &DacrtParams::default(), &[Some(*ray)], &mut out, stats);
+        out[0]
     }
 }

@@ -2,6 +2,7 @@
 //! passes that add new samples, and depth of field that blurs only what is out of focus.
 
 use glam::Vec3;
+use raylab_core::dacrt::Dacrt;
 use raylab_core::distribution::{Accumulator, DistributionSettings, render_pass};
 use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::mbvh::Mbvh;
@@ -18,11 +19,14 @@ fn every_method_traces_the_same_paths() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();
     let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
     let mbvh = Mbvh::build(&scene);
+    let dacrt = Dacrt::new(&scene);
     let cam = scene.default_view().unwrap().camera;
     let light = scene.lights[0];
     let s = settings();
     let image = |method| {
-        let tracer = Tracer::new(&tree, None, TraceOptions { method, ..TraceOptions::default() }).with_mbvh(&mbvh);
+        let tracer = Tracer::new(&tree, None, TraceOptions { method, ..TraceOptions::default() })
+            .with_mbvh(&mbvh)
+            .with_dacrt(&dacrt);
         let mut acc = Accumulator::new(s.width, s.height);
         let stats = render_pass(&scene, &tracer, &cam, light, &s, 0, &mut acc);
         assert_eq!(stats.len(), 3, "camera rays and two bounces");
@@ -32,7 +36,7 @@ fn every_method_traces_the_same_paths() {
     };
     let want = image(Method::Mono);
     assert!(want.iter().any(|p| p[0] > 30), "the image is not black");
-    for method in [Method::Packet, Method::Mft, Method::Mbvh, Method::MbvhRs] {
+    for method in [Method::Packet, Method::Mft, Method::Mbvh, Method::MbvhRs, Method::Dacrt] {
         let got = image(method);
         let diff = got.iter().zip(&want).filter(|(a, b)| a != b).count();
         assert_eq!(diff, 0, "{method}: {diff} pixels differ from mono");

@@ -3,6 +3,7 @@
 //! technique meets a case with a known answer.
 
 use glam::Vec3;
+use raylab_core::dacrt::Dacrt;
 use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
@@ -16,9 +17,9 @@ use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::builtin::{self, Detail};
 use raylab_scene::mesh::{Jitter, MeshBuilder};
 
-/// The methods compared with mono (the MBVH's single rays included).
-const COHERENT: [Method; 6] =
-    [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone, Method::Mbvh];
+/// The methods compared with mono (the MBVH's single rays and DACRT's sets included).
+const COHERENT: [Method; 7] =
+    [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone, Method::Mbvh, Method::Dacrt];
 
 fn techniques(light: &PointLight) -> Vec<Shadows> {
     let r = light.radius.max(0.1);
@@ -50,6 +51,7 @@ fn every_technique_gives_the_same_pixels_with_every_method() {
         let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
         let bf = BruteForce::new(&scene);
         let mbvh = Mbvh::build(&scene);
+        let dacrt = Dacrt::new(&scene);
         let cam = scene.default_view().unwrap().camera;
         let light = scene.lights[0];
         for shadows in techniques(&light) {
@@ -59,8 +61,9 @@ fn every_technique_gives_the_same_pixels_with_every_method() {
             assert!(lit > want.len() / 4, "{name} {shadows}: the frame is mostly dark ({lit} lit pixels)");
             for method in COHERENT {
                 for tile in [4, 16] {
-                    let tracer =
-                        Tracer::new(&tree, None, TraceOptions { method, ..Default::default() }).with_mbvh(&mbvh);
+                    let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() })
+                        .with_mbvh(&mbvh)
+                        .with_dacrt(&dacrt);
                     let got = frame(&scene, &tracer, &cam, light, shadows, tile);
                     let diff = got.iter().zip(&want).filter(|(a, b)| a != b).count();
                     assert_eq!(diff, 0, "{name}, {shadows}, {method} tile {tile}: {diff} pixels differ from mono");

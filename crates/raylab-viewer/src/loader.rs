@@ -1,4 +1,4 @@
-//! Loading a scene and building its kd-tree and MBVH on a background thread, so the window keeps drawing (and the
+//! Loading a scene and building its kd-tree and MBVH (and DACRT's triangle copy) on a background thread, so the window keeps drawing (and the
 //! current scene stays usable) while a large model loads; a failure leaves the current scene in place.
 
 use std::sync::mpsc::{self, Receiver, TryRecvError};
@@ -6,6 +6,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use raylab_bench::args::SceneArgs;
+use raylab_core::dacrt::Dacrt;
 use raylab_core::kdtree::{KdParams, KdStats, KdTree};
 use raylab_core::mbvh::Mbvh;
 use raylab_core::scene::{Camera, PointLight, Scene};
@@ -20,6 +21,8 @@ pub struct LoadedScene {
     pub tree: KdTree,
     /// Its 4-wide BVH, for the mbvh method.
     pub mbvh: Mbvh,
+    /// Its triangles prepared for divide-and-conquer tracing (a copy, no structure), for the dacrt method.
+    pub dacrt: Dacrt,
     /// The camera the scene opened with (the flags, the scene's default view, or a view of the whole scene).
     pub camera: Camera,
     /// The benchmark light.
@@ -46,6 +49,7 @@ pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Re
     let tree = KdTree::build(&scene, params).map_err(|e| format!("{}: {e}", args.scene))?;
     stage("building MBVH");
     let mbvh = Mbvh::build(&scene);
+    let dacrt = Dacrt::new(&scene);
     let name = std::path::Path::new(&args.scene)
         .file_name()
         .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
@@ -56,6 +60,7 @@ pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Re
         scene,
         tree,
         mbvh,
+        dacrt,
         camera,
         light,
         load_s: t0.elapsed().as_secs_f64(),

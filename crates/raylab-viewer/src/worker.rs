@@ -250,7 +250,8 @@ pub fn trace_frame(job: &Job, method: Method) -> Rendered {
     let s = &job.scene;
     let settings = job.settings.render_settings(job.size.0, job.size.1);
     let tracer = Tracer::new(&s.tree, None, raylab_core::trace::TraceOptions { method, ..job.settings.trace })
-        .with_mbvh(&s.mbvh);
+        .with_mbvh(&s.mbvh)
+        .with_dacrt(&s.dacrt);
     let t0 = Instant::now();
     let frame = render(&s.scene, &tracer, &job.camera, job.light, &settings);
     Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings, paths: None }
@@ -262,7 +263,7 @@ fn distribution_pass(p: &mut Progressive) -> Rendered {
     let s = &job.scene;
     let (w, h) = (p.acc.width, p.acc.height);
     let settings = job.settings.distribution.settings(w, h, job.settings.tile);
-    let tracer = Tracer::new(&s.tree, None, job.settings.trace).with_mbvh(&s.mbvh);
+    let tracer = Tracer::new(&s.tree, None, job.settings.trace).with_mbvh(&s.mbvh).with_dacrt(&s.dacrt);
     let mut camera = job.camera;
     camera.aperture = job.settings.distribution.aperture;
     let light = job.light.soft();

@@ -148,13 +148,15 @@ fn window_shows_the_traced_frame_unchanged_for_every_method_and_shadow_technique
     }
     // The soft techniques, each with one method (the method changes no pixels; tests/shadows.rs in
     // raylab-scene proves that for every pair).
-    // The MBVH methods, which the viewer builds an MBVH for, ride along here.
+    // The MBVH methods, which the viewer builds an MBVH for, and DACRT, which it prepares a triangle copy for,
+    // ride along here.
     for (method, flag) in [
         (Method::Packet, "cached"),
         (Method::Mft, "edge"),
         (Method::Mono, "ms4"),
         (Method::Mbvh, "hard"),
         (Method::MbvhRs, "hard"),
+        (Method::Dacrt, "cached"),
     ] {
         let name = format!("{method}-{flag}");
         let (shot, stats) = run_viewer(dir.path(), &name, false, &["--method", method.name(), "--shadows", flag]);

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use clap::Args;
+use raylab_core::dacrt::Dacrt;
 use raylab_core::kdtree::KdTree;
 use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
@@ -17,6 +18,10 @@ use crate::args::{KdArgs, SceneArgs, in_range};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene, with_spinner};
 use crate::timing::{HARNESS_TILE, TraceReport, measure, validate};
+
+/// Tile edge of DACRT's ray sets on the diffuse rays: 65,536 rays a set, four sets for 512x512 (so two threads
+/// share the work); smaller sets repeat the division of the scene's triangles more often.
+const DACRT_TILE: u32 = 256;
 
 /// Compares raylab's single-ray kd-tree with Embree's single-ray API on the harness's rays.
 #[derive(Args, Debug)]
@@ -49,9 +54,10 @@ pub struct CompareArgs {
     /// Coherent methods to measure beside Embree's packet and stream APIs (primary and shadow rays).
     #[arg(long, value_delimiter = ',', default_value = "packet,frustum,mft,cone,mft-cone")]
     methods: Vec<Method>,
-    /// MBVH methods to measure on the diffuse (incoherent) rays beside Embree's `rtcIntersect1` and
-    /// `rtcIntersect1M` (mbvh-rs traces each 16x16 tile as one group of 256 rays).
-    #[arg(long, value_delimiter = ',', default_value = "mbvh,mbvh-rs")]
+    /// Methods to measure on the diffuse (incoherent) rays beside Embree's `rtcIntersect1` and
+    /// `rtcIntersect1M` (mbvh-rs traces each 16x16 tile as one group of 256 rays, dacrt each 256x256 tile as
+    /// one set).
+    #[arg(long, value_delimiter = ',', default_value = "mbvh,mbvh-rs,dacrt")]
     incoherent: Vec<Method>,
     /// Tile sizes for the frustum methods.
     #[arg(long, value_delimiter = ',', default_value = "4,8,16", value_parser = in_range(2, 256))]
@@ -179,30 +185,41 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         }
     }
 
-    // Incoherent rays: the MBVH methods on the diffuse rays (MBVH RS paper).
+    // Incoherent rays: the MBVH methods (MBVH RS paper) and DACRT (seed 003) on the diffuse rays.
     let mut mbvh_builds = Vec::new();
+    let mut dacrt_setup = None;
     let mut incoherent: Vec<(Method, TraceReport)> = Vec::new();
-    let mbvh_methods: Vec<Method> = a.incoherent.iter().copied().filter(|m| m.uses_mbvh()).collect();
-    if !mbvh_methods.is_empty() {
+    if !a.incoherent.is_empty() {
         let mut mbvh = None;
-        for &t in &a.threads {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(t as usize).build().map_err(|e| e.to_string())?;
-            let mut times = Vec::new();
-            for _ in 0..a.builds {
-                let built = pool.install(|| Mbvh::build(&scene));
-                times.push(built.build_time().as_secs_f64());
-                mbvh = Some(built);
-            }
-            times.sort_by(f64::total_cmp);
-            mbvh_builds.push((t, times[times.len() / 2]));
-        }
-        let mbvh = mbvh.ok_or("--threads: no thread count given")?;
-        let workload = wb.build(RayKind::Diffuse);
-        for &method in &mbvh_methods {
+        if a.incoherent.iter().any(|m| m.uses_mbvh()) {
             for &t in &a.threads {
-                let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() }).with_mbvh(&mbvh);
+                let pool =
+                    rayon::ThreadPoolBuilder::new().num_threads(t as usize).build().map_err(|e| e.to_string())?;
+                let mut times = Vec::new();
+                for _ in 0..a.builds {
+                    let built = pool.install(|| Mbvh::build(&scene));
+                    times.push(built.build_time().as_secs_f64());
+                    mbvh = Some(built);
+                }
+                times.sort_by(f64::total_cmp);
+                mbvh_builds.push((t, times[times.len() / 2]));
+            }
+        }
+        let dacrt = a.incoherent.iter().any(|m| m.uses_dacrt()).then(|| Dacrt::new(&scene));
+        dacrt_setup = dacrt.as_ref().map(|d| d.setup_time().as_secs_f64());
+        let workload = wb.build(RayKind::Diffuse);
+        for &method in &a.incoherent {
+            for &t in &a.threads {
+                let mut tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
+                if let Some(m) = &mbvh {
+                    tracer = tracer.with_mbvh(m);
+                }
+                if let Some(d) = &dacrt {
+                    tracer = tracer.with_dacrt(d);
+                }
+                let tile = if method.uses_dacrt() { DACRT_TILE } else { HARNESS_TILE };
                 let (report, results) =
-                    measure(&tracer, &workload, HARNESS_TILE, t as usize, a.warmup as usize, a.reps as usize)?;
+                    measure(&tracer, &workload, tile, t as usize, a.warmup as usize, a.reps as usize)?;
                 validate(&reference, &workload, &results, 256)
                     .map_err(|m| format!("validation failed ({method}): {m}"))?;
                 incoherent.push((method, report));
@@ -310,11 +327,14 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     if !incoherent.is_empty() {
         let _ = writeln!(
             md,
-            "\nIncoherent rays: the MBVH methods on the diffuse rays against Embree's single-ray and stream APIs \
-             (per ray: 4-box SIMD tests, node fetches, triangle tests; MBVH RS groups are 16x16 tiles, 256 rays). \
-             MBVH builds (median of {}): {}.\n",
+            "\nIncoherent rays: the MBVH methods and DACRT on the diffuse rays against Embree's single-ray and \
+             stream APIs (per ray: 4-box SIMD tests, node fetches, triangle tests; MBVH RS groups are 16x16 tiles, \
+             256 rays; DACRT traces {DACRT_TILE}x{DACRT_TILE} tiles as sets, and its box tests are ray-box filter \
+             tests, its fetches recursion nodes). MBVH builds (median of {}): {}. DACRT setup (copying the \
+             triangles, its only preparation, not in the rates): {}.\n",
             a.builds,
-            mbvh_builds.iter().map(|(t, s)| format!("{s:.3} s on {t} thread(s)")).collect::<Vec<_>>().join(", ")
+            mbvh_builds.iter().map(|(t, s)| format!("{s:.3} s on {t} thread(s)")).collect::<Vec<_>>().join(", "),
+            dacrt_setup.map_or("n/a".to_string(), |s| format!("{:.1} ms", s * 1e3))
         );
         let _ = writeln!(
             md,

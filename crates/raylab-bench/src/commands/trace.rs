@@ -1,6 +1,7 @@
 //! `raylab-bench trace`: throughput of one method on the harness's rays.
 
 use clap::Args;
+use raylab_core::dacrt::Dacrt;
 use raylab_core::mbvh::Mbvh;
 use raylab_core::reference::BruteForce;
 use raylab_core::trace::Tracer;
@@ -68,9 +69,13 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         pool.map(|p| with_spinner("building MBVH", || p.install(|| Mbvh::build(&scene))))
     });
     let mbvh = mbvh.transpose()?;
+    let dacrt = options.method.uses_dacrt().then(|| Dacrt::new(&scene));
     let mut tracer = Tracer::new(&tree, Some(&reference), options);
     if let Some(m) = &mbvh {
         tracer = tracer.with_mbvh(m);
+    }
+    if let Some(d) = &dacrt {
+        tracer = tracer.with_dacrt(d);
     }
     let (report, results) =
         measure(&tracer, &workload, a.m.tile as u32, a.threads as usize, a.warmup as usize, a.reps as usize)?;

@@ -105,7 +105,7 @@ struct TileOut {
 /// (install a pool to choose the thread count).
 pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight, settings: &RenderSettings) -> Frame {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
-    let tile = settings.tile.max(1);
+    let tile = tracer.options.method.tile_edge(settings.tile, 1);
     // Single rays are traced in the chosen order; packet methods need the tile's pixels row by row.
     let order = if tracer.options.method.uses_packets() { RayOrder::Scanline } else { settings.order };
     let ctx = TileContext {
@@ -117,6 +117,7 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
         width: w,
         epsilon: surface_epsilon(scene),
         order,
+        tile,
         offsets: order.offsets(tile, tile),
     };
     let tiles: Vec<(u32, u32)> =
@@ -191,6 +192,8 @@ struct TileContext<'a> {
     width: u32,
     epsilon: f32,
     order: RayOrder,
+    /// Tile edge (the method's, see [`Method::tile_edge`]).
+    tile: u32,
     /// The pixel offsets of a whole tile in `order`, computed once per frame.
     offsets: Vec<(u32, u32)>,
 }
@@ -223,7 +226,7 @@ impl TileContext<'_> {
             self.block((x0, y0), (tw, th), offsets, self.order == RayOrder::Scanline, &mut out, &mut scratch);
             return out;
         }
-        let unit = unit_size(self.tracer.options.method, self.settings.tile.max(1));
+        let unit = unit_size(self.tracer.options.method, self.tile);
         for uy in (0..th).step_by(unit as usize) {
             for ux in (0..tw).step_by(unit as usize) {
                 let start = out.pixels.len();

@@ -2,7 +2,8 @@
 //!
 //! Hard shadows go through the frame's traversal method as one tile of segments ending at the light (so the
 //! frustum methods trace them as frustums from the light, as the thesis does); the shadow cache and edge
-//! widths are single-ray techniques; multi-sampling traces each point's samples as one bundle bounded by
+//! widths are single-ray techniques (DACRT, which traces sets, consults the cache for a whole layer at once);
+//! multi-sampling traces each point's samples as one bundle bounded by
 //! packets, a pyramid or a cone.
 
 use crate::ray::{Hit, Ray};
@@ -80,6 +81,14 @@ impl ShadowTracer<'_> {
             Shadows::None => surfaces.iter().map(|s| if s.is_some() { 1.0 } else { 0.0 }).collect(),
             Shadows::Hard => {
                 self.hard(surfaces, (width, height), stats, sc);
+                sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| if r.is_some() && !b { 1.0 } else { 0.0 }).collect()
+            }
+            Shadows::Cached if self.tracer.options.method.uses_dacrt() => {
+                sc.rays.clear();
+                sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(to_center)));
+                sc.blocked.clear();
+                sc.blocked.resize(sc.rays.len(), false);
+                sc.cache.occluded_set(self.tracer, &sc.rays, &mut sc.blocked, stats);
                 sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| if r.is_some() && !b { 1.0 } else { 0.0 }).collect()
             }
             Shadows::Cached => surfaces

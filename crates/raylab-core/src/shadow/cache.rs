@@ -39,4 +39,44 @@ impl ShadowCache {
             None => false,
         }
     }
+
+    /// [`ShadowCache::occluded`] for a whole set of rays at once, for methods that trace sets (DACRT): every
+    /// ray tests the cached triangle, the others are traced together, and the last blocker they find becomes
+    /// the cached triangle. `out` receives the occlusion of each ray (`false` for `None`).
+    pub fn occluded_set(
+        &mut self,
+        tracer: &Tracer,
+        rays: &[Option<Ray>],
+        out: &mut [bool],
+        stats: &mut TraversalStats,
+    ) {
+        assert_eq!(rays.len(), out.len());
+        let mut rest: Vec<Option<Ray>> = Vec::with_capacity(rays.len());
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            *o = false;
+            let cached = match (r, self.last) {
+                (Some(r), Some(tri)) => {
+                    stats.cache_lookups += 1;
+                    stats.isect_tests += 1;
+                    tracer.blocks(r, tri)
+                }
+                _ => false,
+            };
+            if cached {
+                stats.cache_hits += 1;
+                stats.rays += 1;
+                stats.packets += 1;
+                *o = true;
+            }
+            rest.push(if cached { None } else { *r });
+        }
+        let mut found = vec![None; rest.len()];
+        tracer.occluders_tile(&rest, &mut found, stats);
+        for (o, f) in out.iter_mut().zip(&found) {
+            if let Some(tri) = f {
+                *o = true;
+                self.last = Some(*tri);
+            }
+        }
+    }
 }

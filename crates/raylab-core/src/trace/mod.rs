@@ -9,6 +9,7 @@ use glam::Vec3;
 use raylab_simd::{Backend, VMask, Vf32};
 use serde::Serialize;
 
+use crate::dacrt::{Dacrt, DacrtParams};
 use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
 use crate::mbvh::Mbvh;
@@ -37,6 +38,8 @@ pub struct TraceOptions {
     /// Order MBVH RS child tasks by accumulated hit length (the paper's heuristic; off walks them in lane
     /// order, to measure its gain).
     pub stream_order: bool,
+    /// DACRT's leaf thresholds and split rule.
+    pub dacrt: DacrtParams,
 }
 
 fn backend_name<S: serde::Serializer>(b: &Backend, s: S) -> Result<S::Ok, S::Error> {
@@ -56,6 +59,7 @@ impl Default for TraceOptions {
             backend: Backend::detect(),
             shadow_spread_limit: Self::SHADOW_SPREAD_LIMIT,
             stream_order: true,
+            dacrt: DacrtParams::default(),
         }
     }
 }
@@ -65,6 +69,7 @@ pub struct Tracer<'a> {
     tree: &'a KdTree,
     reference: Option<&'a BruteForce>,
     mbvh: Option<&'a Mbvh>,
+    dacrt: Option<&'a Dacrt>,
     /// The options.
     pub options: TraceOptions,
 }
@@ -76,12 +81,21 @@ const TOWARD_TOLERANCE: f32 = 1e-3;
 impl<'a> Tracer<'a> {
     /// A tracer over `tree`; `reference` is needed only for [`Method::Reference`].
     pub fn new(tree: &'a KdTree, reference: Option<&'a BruteForce>, options: TraceOptions) -> Self {
-        Self { tree, reference, mbvh: None, options }
+        Self { tree, reference, mbvh: None, dacrt: None, options }
     }
 
     /// The same tracer with an MBVH over the same scene, needed for [`Method::Mbvh`].
     pub fn with_mbvh(self, mbvh: &'a Mbvh) -> Self {
         Self { mbvh: Some(mbvh), ..self }
+    }
+
+    /// The same tracer with the scene prepared for divide-and-conquer tracing, needed for [`Method::Dacrt`].
+    pub fn with_dacrt(self, dacrt: &'a Dacrt) -> Self {
+        Self { dacrt: Some(dacrt), ..self }
+    }
+
+    fn dacrt(&self) -> &'a Dacrt {
+        self.dacrt.expect("the dacrt method needs a Dacrt (Tracer::with_dacrt)")
     }
 
     fn mbvh(&self) -> &'a Mbvh {
@@ -95,6 +109,7 @@ impl<'a> Tracer<'a> {
             tree: self.tree,
             reference: self.reference,
             mbvh: self.mbvh,
+            dacrt: self.dacrt,
             options: TraceOptions { method, ..self.options },
         }
     }
@@ -104,7 +119,25 @@ impl<'a> Tracer<'a> {
         match self.options.method {
             Method::Reference => self.reference().occluder(ray, stats),
             Method::Mbvh | Method::MbvhRs => self.mbvh().occluder(ray, stats),
+            Method::Dacrt => {
+                let mut out = [None];
+                self.dacrt().occluders(&self.options.dacrt, &[Some(*ray)], &mut out, stats);
+                out[0]
+            }
             _ => self.tree.occluder(ray, stats),
+        }
+    }
+
+    /// The first blocker found along each of `rays` (`None` entries and unblocked rays give `None`): one set
+    /// for DACRT, ray by ray for the other methods.
+    pub fn occluders_tile(&self, rays: &[Option<Ray>], out: &mut [Option<u32>], stats: &mut TraversalStats) {
+        assert_eq!(rays.len(), out.len());
+        if self.options.method == Method::Dacrt {
+            self.dacrt().occluders(&self.options.dacrt, rays, out, stats);
+            return;
+        }
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = r.and_then(|r| self.occluder(&r, stats));
         }
     }
 
@@ -112,13 +145,15 @@ impl<'a> Tracer<'a> {
     pub fn blocks(&self, ray: &Ray, tri: u32) -> bool {
         match self.options.method {
             Method::Reference => self.reference().blocks(ray, tri),
+            Method::Dacrt => self.dacrt().blocks(ray, tri),
             _ => self.tree.blocks(ray, tri),
         }
     }
 
     /// The edge-width occlusion of a single shadow ray (thesis Listing 5.1). Edge-width rays are traced one
-    /// at a time by every method: the kd-tree kernel (also for [`Method::Mbvh`]: a BVH does not visit leaves in
-    /// distance order, which the pairing relies on), or the brute-force reference for [`Method::Reference`].
+    /// at a time by every method: the kd-tree kernel (also for the MBVH and DACRT methods, which do not visit
+    /// leaves in distance order, which the pairing relies on), or the brute-force reference for
+    /// [`Method::Reference`].
     pub fn edge_width(&self, ray: &Ray, state: &mut EdgeWidth, stats: &mut TraversalStats) -> f32 {
         match self.options.method {
             Method::Reference => self.reference().edge_width(ray, state, stats),
@@ -159,6 +194,7 @@ impl<'a> Tracer<'a> {
                 }
             }
             Method::MbvhRs => self.mbvh().intersect_stream(rays, out, self.options.stream_order, stats),
+            Method::Dacrt => self.dacrt().intersect(&self.options.dacrt, rays, out, stats),
             _ => match self.options.backend {
                 #[cfg(target_arch = "x86_64")]
                 Backend::Sse => self.intersect_simd::<raylab_simd::sse::F32x4>(rays, width, height, out, stats),
@@ -197,6 +233,7 @@ impl<'a> Tracer<'a> {
                 }
             }
             Method::MbvhRs => self.mbvh().occluded_stream(rays, out, self.options.stream_order, stats),
+            Method::Dacrt => self.dacrt().occluded(&self.options.dacrt, rays, out, stats),
             _ => match self.options.backend {
                 #[cfg(target_arch = "x86_64")]
                 Backend::Sse => self.occluded_simd::<raylab_simd::sse::F32x4>(rays, width, height, toward, out, stats),

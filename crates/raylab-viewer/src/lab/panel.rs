@@ -1,6 +1,7 @@
 //! The side panel: every switch of the tracer, grouped as a user reaches for them (scene, camera, rendering,
 //! view), with the readouts below.
 
+use raylab_core::dacrt::{DacrtParams, SplitRule};
 use raylab_core::method::Method;
 use raylab_core::render::{FrameView, RayOrder};
 use raylab_simd::Backend;
@@ -201,6 +202,9 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
         )
         .on_hover_text("walk MBVH RS children by accumulated hit length (the paper's heuristic)")
         .on_disabled_hover_text("only mbvh-rs orders its child tasks");
+        if s.trace.method.uses_dacrt() {
+            dacrt_controls(ui, s);
+        }
         egui::ComboBox::from_label("SIMD").selected_text(s.trace.backend.name()).show_ui(ui, |ui| {
             for b in Backend::available() {
                 ui.selectable_value(&mut s.trace.backend, b, b.name());
@@ -307,5 +311,24 @@ fn view_section(lab: &mut Lab, ui: &mut egui::Ui) {
     });
     if lab.settings != before {
         lab.dirty = true;
+    }
+}
+
+/// DACRT's leaf thresholds and split rule, and the tile it really traces.
+fn dacrt_controls(ui: &mut egui::Ui, s: &mut ViewerSettings) {
+    let d = &mut s.trace.dacrt;
+    let max = DacrtParams::MAX_LEAF.min(256);
+    ui.add(egui::Slider::new(&mut d.leaf_rays, 1..=max).logarithmic(true).text("leaf rays"))
+        .on_hover_text("a node with at most this many rays is tested naively");
+    ui.add(egui::Slider::new(&mut d.leaf_tris, 1..=max).logarithmic(true).text("leaf triangles"))
+        .on_hover_text("a node with at most this many triangles is tested naively");
+    egui::ComboBox::from_label("split").selected_text(d.split.name()).show_ui(ui, |ui| {
+        for r in SplitRule::ALL {
+            ui.selectable_value(&mut d.split, r, r.name());
+        }
+    });
+    let edge = Method::Dacrt.tile_edge(s.tile, 1);
+    if edge != s.tile {
+        ui.small(format!("DACRT traces {edge}x{edge} tiles: smaller ray sets repeat the division of every triangle"));
     }
 }

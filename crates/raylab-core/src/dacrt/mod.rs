@@ -1,0 +1,181 @@
+//! Divide-and-conquer ray tracing (DACRT: Mora 2011, "Naive ray-tracing: a divide-and-conquer approach", with
+//! Afra 2012's improvements; seed 003, Stokes 2014, section 2.5 and 3.3): rays are traced without any stored
+//! acceleration structure. A set of rays and a set of triangles are divided together: the triangles are split
+//! in two ([`split`]), the rays filtered against each half's box in SIMD ([`filter`]), and each half recursed
+//! with the rays that reach it ([`traverse`]), until few rays or few triangles are left to test naively.
+//!
+//! The only preparation is a linear pass that copies the triangles and their boxes ([`Dacrt::new`]), so
+//! geometry that moves every frame costs nothing to "rebuild". The work is amortised over the rays of one
+//! call: DACRT wants large ray sets (a whole G-buffer's reflection rays, or large tiles), not single rays.
+
+mod filter;
+mod records;
+mod split;
+mod traverse;
+
+pub use split::SplitRule;
+
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use raylab_simd::{Backend, Vf32};
+use serde::{Deserialize, Serialize};
+
+use crate::ray::{Hit, Ray};
+use crate::scene::Scene;
+use crate::stats::TraversalStats;
+use crate::triangle::TriangleSoup;
+use records::{RayRecord, SetBounds, TriRecord};
+use traverse::{Answer, Any, Blocker, Closest, Walk};
+
+/// When DACRT stops dividing and how it divides.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DacrtParams {
+    /// A node with at most this many rays is tested naively.
+    pub leaf_rays: usize,
+    /// A node with at most this many triangles is tested naively.
+    pub leaf_tris: usize,
+    /// How triangles are divided.
+    pub split: SplitRule,
+}
+
+impl Default for DacrtParams {
+    fn default() -> Self {
+        Self { leaf_rays: 8, leaf_tris: 8, split: SplitRule::Sah }
+    }
+}
+
+impl DacrtParams {
+    /// Largest leaf threshold accepted (a naive leaf's cost is rays x triangles).
+    pub const MAX_LEAF: usize = 4096;
+}
+
+/// Per-call working memory: the triangle references (a permutation of the scene's, reused from call to call),
+/// the moved rays and the filter's flags.
+struct Scratch {
+    tris: Vec<TriRecord>,
+    rays: Vec<RayRecord>,
+    flags: Vec<u8>,
+}
+
+/// A scene prepared for divide-and-conquer tracing: its triangles and their boxes, nothing more.
+pub struct Dacrt {
+    soup: TriangleSoup,
+    refs: Vec<TriRecord>,
+    root: SetBounds,
+    setup_time: Duration,
+    /// Working memory of finished calls, reused by the next ones (one per thread that traced).
+    pool: Mutex<Vec<Scratch>>,
+    /// SIMD backend of the ray filter.
+    pub backend: Backend,
+}
+
+impl Dacrt {
+    /// Copies the triangles of `scene` and their boxes: a linear pass, the whole "build".
+    pub fn new(scene: &Scene) -> Self {
+        let start = Instant::now();
+        let soup = TriangleSoup::from_scene(scene);
+        let refs: Vec<TriRecord> =
+            soup.as_slice().iter().enumerate().map(|(i, t)| TriRecord::new(*t, i as u32)).collect();
+        let root = SetBounds::of(&refs);
+        Self { soup, refs, root, setup_time: start.elapsed(), pool: Mutex::new(Vec::new()), backend: Backend::detect() }
+    }
+
+    /// How long [`Dacrt::new`] took.
+    pub fn setup_time(&self) -> Duration {
+        self.setup_time
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.refs.len()
+    }
+
+    /// Closest hits in `(tmin, tmax]` of all `rays` (`None` entries are skipped), written to `out`; among hits
+    /// at one distance the lowest triangle id wins.
+    pub fn intersect(
+        &self,
+        p: &DacrtParams,
+        rays: &[Option<Ray>],
+        out: &mut [Option<Hit>],
+        stats: &mut TraversalStats,
+    ) {
+        assert_eq!(rays.len(), out.len());
+        out.fill(None);
+        self.run(p, rays, Closest { out }, stats);
+    }
+
+    /// Whether anything blocks each of `rays` in `(tmin, tmax]`, written to `out`.
+    pub fn occluded(&self, p: &DacrtParams, rays: &[Option<Ray>], out: &mut [bool], stats: &mut TraversalStats) {
+        assert_eq!(rays.len(), out.len());
+        out.fill(false);
+        self.run(p, rays, Any { out }, stats);
+    }
+
+    /// The first blocker found along each of `rays` (not necessarily the nearest), for the shadow cache.
+    pub fn occluders(
+        &self,
+        p: &DacrtParams,
+        rays: &[Option<Ray>],
+        out: &mut [Option<u32>],
+        stats: &mut TraversalStats,
+    ) {
+        assert_eq!(rays.len(), out.len());
+        out.fill(None);
+        self.run(p, rays, Blocker { out }, stats);
+    }
+
+    /// True when triangle `tri` blocks `ray`.
+    pub fn blocks(&self, ray: &Ray, tri: u32) -> bool {
+        ray.is_valid()
+            && (tri as usize) < self.soup.len()
+            && crate::triangle::RayShear::new(ray).intersect(self.soup.get(tri), ray.tmin, ray.tmax).is_some()
+    }
+
+    fn run<A: Answer>(&self, p: &DacrtParams, rays: &[Option<Ray>], answer: A, stats: &mut TraversalStats) {
+        let mut scratch = self.take_scratch();
+        scratch.rays.clear();
+        scratch.rays.extend(
+            rays.iter().enumerate().filter_map(|(i, r)| r.filter(Ray::is_valid).map(|r| RayRecord::new(&r, i as u32))),
+        );
+        stats.rays += scratch.rays.len() as u64;
+        stats.packets += scratch.rays.len() as u64;
+        if !scratch.rays.is_empty() && !self.refs.is_empty() {
+            let mut walk = Walk {
+                params: *p,
+                answer,
+                flags: std::mem::take(&mut scratch.flags),
+                stats: TraversalStats::default(),
+            };
+            match self.backend {
+                #[cfg(target_arch = "x86_64")]
+                Backend::Sse => self.start::<raylab_simd::sse::F32x4, A>(&mut walk, &mut scratch),
+                _ => self.start::<raylab_simd::scalar::F32x4, A>(&mut walk, &mut scratch),
+            }
+            scratch.flags = walk.flags;
+            *stats += walk.stats;
+        }
+        self.pool.lock().unwrap_or_else(|e| e.into_inner()).push(scratch);
+    }
+
+    /// Filters the rays against the scene's box, then recurses.
+    fn start<V: Vf32, A: Answer>(&self, walk: &mut Walk<A>, scratch: &mut Scratch) {
+        let Scratch { tris, rays, .. } = scratch;
+        walk.stats.box_tests += rays.len() as u64;
+        let k = filter::filter::<V>(rays, &filter::FilterBox::new(&self.root.bounds), &mut walk.flags);
+        if k > 0 {
+            walk.recurse::<V>(&mut rays[..k], tris, self.root, 0);
+        }
+    }
+
+    fn take_scratch(&self) -> Scratch {
+        let reused = self.pool.lock().unwrap_or_else(|e| e.into_inner()).pop();
+        reused.unwrap_or_else(|| Scratch { tris: self.refs.clone(), rays: Vec::new(), flags: Vec::new() })
+    }
+}
+
+impl std::fmt::Debug for Dacrt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Dacrt").field("triangles", &self.refs.len()).field("backend", &self.backend).finish()
+    }
+}

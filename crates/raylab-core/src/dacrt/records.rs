@@ -1,0 +1,99 @@
+//! The compact records DACRT moves around (Afra 2012, as Stokes's thesis section 3.3 describes them): a ray
+//! carries what filtering and the leaves need and is moved whole, so every pass reads rays linearly; a
+//! triangle reference carries its box (for partitioning and for the children's boxes) and the id of its full
+//! record, which only leaves fetch.
+
+use glam::Vec3;
+
+use crate::aabb::Aabb;
+use crate::ray::Ray;
+
+/// A ray as DACRT stores it: 48 bytes, moved (not indexed) by every filter pass.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub(super) struct RayRecord {
+    /// Start point.
+    pub org: Vec3,
+    /// Smallest accepted hit distance.
+    pub tmin: f32,
+    /// Direction (unnormalised, as given).
+    pub dir: Vec3,
+    /// Largest accepted hit distance: the closest hit so far, or `-inf` once an occlusion query is answered,
+    /// which makes every later box test fail.
+    pub tmax: f32,
+    /// Component-wise inverse direction (infinite for zero components).
+    pub inv: Vec3,
+    /// Index of the ray in the caller's slice, where its result goes.
+    pub id: u32,
+}
+
+impl RayRecord {
+    /// The record of `ray`, the `id`-th of the caller's rays.
+    pub fn new(ray: &Ray, id: u32) -> Self {
+        Self { org: ray.origin, tmin: ray.tmin, dir: ray.dir, tmax: ray.tmax, inv: ray.inv_dir(), id }
+    }
+
+    /// The ray over its current interval.
+    pub fn ray(&self) -> Ray {
+        Ray::segment(self.org, self.dir, self.tmin, self.tmax)
+    }
+}
+
+/// A triangle as DACRT moves it: its corners and its id in the scene (40 bytes). Carrying the corners costs a
+/// few more bytes per move than a box would, and spares the leaves a scattered fetch per test.
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+pub(super) struct TriRecord {
+    /// The corners.
+    pub v: [Vec3; 3],
+    /// Scene index of the triangle.
+    pub id: u32,
+}
+
+impl TriRecord {
+    /// The record of triangle `id` with corners `v`.
+    pub fn new(v: [Vec3; 3], id: u32) -> Self {
+        Self { v, id }
+    }
+
+    /// The box.
+    #[inline(always)]
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(self.v[0].min(self.v[1]).min(self.v[2]), self.v[0].max(self.v[1]).max(self.v[2]))
+    }
+
+    /// Twice the box centre on `axis` (the partitions only compare centres, so the halving is skipped).
+    #[inline(always)]
+    pub fn centre2(&self, axis: usize) -> f32 {
+        let (a, b, c) = (self.v[0][axis], self.v[1][axis], self.v[2][axis]);
+        a.min(b).min(c) + a.max(b).max(c)
+    }
+}
+
+/// The box and centre box of a set of triangle references.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SetBounds {
+    /// Union of the triangles' boxes.
+    pub bounds: Aabb,
+    /// Bounds of the doubled centres ([`TriRecord::centre2`]).
+    pub centres: Aabb,
+}
+
+impl SetBounds {
+    /// Bounds of `tris`.
+    pub fn of(tris: &[TriRecord]) -> Self {
+        tris.iter().fold(SetBounds { bounds: Aabb::EMPTY, centres: Aabb::EMPTY }, |s, t| s.grow(t))
+    }
+
+    /// These bounds grown by one triangle.
+    #[inline(always)]
+    pub fn grow(self, t: &TriRecord) -> Self {
+        let b = t.bounds();
+        SetBounds { bounds: self.bounds.union(b), centres: self.centres.grow(b.min + b.max) }
+    }
+
+    /// The union of two bounds.
+    pub fn union(self, o: SetBounds) -> Self {
+        SetBounds { bounds: self.bounds.union(o.bounds), centres: self.centres.union(o.centres) }
+    }
+}

@@ -1,0 +1,176 @@
+//! The divide-and-conquer recursion (Mora 2011; Stokes's thesis, Figure 1 and section 3.3): divide the
+//! triangles in two, filter the rays against each half's box, recurse with the rays that pass, and test what is
+//! left naively once a node is small. The half nearer to most rays goes first, so their closest hits shorten
+//! their intervals before the other half is filtered.
+
+use raylab_simd::{VMask, Vf32};
+
+use super::DacrtParams;
+use super::filter::{FilterBox, classify, partition};
+use super::records::{RayRecord, SetBounds, TriRecord};
+use super::split::divide;
+use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
+use crate::ray::Hit;
+use crate::stats::TraversalStats;
+
+/// Depth past which nodes are leaves whatever their size; the median and middle-of-list cuts keep real
+/// recursions far shallower (a lopsided SAH cut still removes one bin's worth of triangles).
+const MAX_DEPTH: u32 = 96;
+/// Rays sampled to decide which half is nearer.
+const ORDER_SAMPLES: usize = 16;
+
+/// What a leaf does with the rays that reach it: closest hits, occlusion or first blockers. The rays are
+/// packed four at a time into temporary SoA packets (as MBVH RS leaves do) and each triangle is tested against
+/// a packet at once with the watertight test, bit for bit what the single-ray test reports.
+pub(super) trait Answer {
+    /// Tests every ray of `rays` against every triangle of `tris`, updating the rays' intervals.
+    fn leaf<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &[TriRecord]);
+}
+
+/// Four rays (or fewer, at the end) in a temporary packet.
+fn packets<V: Vf32>(rays: &mut [RayRecord]) -> impl Iterator<Item = (&mut [RayRecord], RayPacket<V>)> {
+    rays.chunks_mut(4).map(|group| {
+        let mut lanes = [None; 4];
+        for (l, r) in lanes.iter_mut().zip(group.iter()) {
+            *l = Some(r.ray());
+        }
+        let p = RayPacket::<V>::new(&lanes[..group.len()]);
+        (group, p)
+    })
+}
+
+/// Closest hits, written at each ray's id.
+pub(super) struct Closest<'a> {
+    pub out: &'a mut [Option<Hit>],
+}
+
+impl Answer for Closest<'_> {
+    fn leaf<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &[TriRecord]) {
+        for (group, p) in packets::<V>(rays) {
+            let mut hits = PacketHits::new(&p);
+            for t in tris {
+                intersect_packet(&p, &mut hits, &t.v, t.id, p.valid);
+            }
+            let found = hits.to_hits();
+            for (r, h) in group.iter_mut().zip(found) {
+                let Some(h) = h else { continue };
+                let best = &mut self.out[r.id as usize];
+                // Equal distances go to the lower triangle id, as in the brute-force reference.
+                if best.is_none_or(|b| h.t < b.t || h.tri < b.tri) {
+                    *best = Some(h);
+                    r.tmax = h.t;
+                }
+            }
+        }
+    }
+}
+
+/// The lanes of packet `p` that some triangle of `tris` blocks, and for each lane the first such triangle.
+fn blocked<V: Vf32>(p: &RayPacket<V>, tris: &[TriRecord]) -> (u32, [u32; 4]) {
+    let mut open = p.valid;
+    let mut first = [u32::MAX; 4];
+    for t in tris {
+        let hit = occlude_packet(p, &t.v, open);
+        if hit.any() {
+            let bits = hit.bits();
+            for (k, f) in first.iter_mut().enumerate() {
+                if bits >> k & 1 == 1 {
+                    *f = t.id;
+                }
+            }
+            open = open & !hit;
+            if open.none() {
+                break;
+            }
+        }
+    }
+    (p.valid.bits() & !open.bits(), first)
+}
+
+/// Occlusion flags, written at each ray's id; an answered ray's interval is emptied so no box takes it again.
+pub(super) struct Any<'a> {
+    pub out: &'a mut [bool],
+}
+
+impl Answer for Any<'_> {
+    fn leaf<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &[TriRecord]) {
+        for (group, p) in packets::<V>(rays) {
+            let (bits, _) = blocked(&p, tris);
+            for (k, r) in group.iter_mut().enumerate() {
+                if bits >> k & 1 == 1 {
+                    self.out[r.id as usize] = true;
+                    r.tmax = f32::NEG_INFINITY;
+                }
+            }
+        }
+    }
+}
+
+/// The first blocker found for each ray (for the shadow cache), written at its id.
+pub(super) struct Blocker<'a> {
+    pub out: &'a mut [Option<u32>],
+}
+
+impl Answer for Blocker<'_> {
+    fn leaf<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &[TriRecord]) {
+        for (group, p) in packets::<V>(rays) {
+            let (bits, first) = blocked(&p, tris);
+            for (k, r) in group.iter_mut().enumerate() {
+                if bits >> k & 1 == 1 {
+                    self.out[r.id as usize] = Some(first[k]);
+                    r.tmax = f32::NEG_INFINITY;
+                }
+            }
+        }
+    }
+}
+
+/// One recursion's shared state.
+pub(super) struct Walk<A> {
+    pub params: DacrtParams,
+    pub answer: A,
+    /// Scratch flags for the filter.
+    pub flags: Vec<u8>,
+    pub stats: TraversalStats,
+}
+
+impl<A: Answer> Walk<A> {
+    /// Traces `rays` against `tris` (bounded by `b`).
+    pub fn recurse<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &mut [TriRecord], b: SetBounds, depth: u32) {
+        self.stats.nodes += 1;
+        let p = self.params;
+        let small = tris.len() <= p.leaf_tris || rays.len() <= p.leaf_rays;
+        let split = if small || depth >= MAX_DEPTH { None } else { divide(tris, &b, p.split) };
+        let Some(s) = split else {
+            self.stats.leaves += 1;
+            self.stats.isect_tests += (rays.len() * tris.len()) as u64;
+            self.answer.leaf::<V>(rays, tris);
+            return;
+        };
+        let step = rays.len().div_ceil(ORDER_SAMPLES);
+        let forward =
+            rays.iter().step_by(step).filter(|r| r.dir[s.axis] >= 0.0).count() * 2 >= rays.len().div_ceil(step);
+        let (lower, upper) = tris.split_at_mut(s.mid);
+        let ((near, near_b), (far, far_b)) =
+            if forward { ((lower, s.first), (upper, s.second)) } else { ((upper, s.second), (lower, s.first)) };
+        // One pass against both boxes: [near (maybe far too) | far only | neither].
+        let boxes = [FilterBox::new(&near_b.bounds), FilterBox::new(&far_b.bounds)];
+        self.stats.box_tests += 2 * rays.len() as u64;
+        classify::<V, 2>(rays, &boxes, &mut self.flags);
+        let n = rays.len();
+        let to_near = partition(rays, &mut self.flags[..n], |f| f & 1 != 0);
+        let far_only = partition(&mut rays[to_near..], &mut self.flags[to_near..n], |f| f & 2 != 0);
+        if to_near > 0 {
+            self.recurse::<V>(&mut rays[..to_near], near, near_b, depth + 1);
+        }
+        // The near half's rays test the far box again with their shortened intervals; those that enter it go
+        // to the back of their range, next to the far-only rays.
+        let near_rays = &mut rays[..to_near];
+        self.stats.box_tests += near_rays.len() as u64;
+        classify::<V, 1>(near_rays, &[boxes[1]], &mut self.flags);
+        let stay = partition(near_rays, &mut self.flags[..to_near], |f| f == 0);
+        if stay < to_near + far_only {
+            self.recurse::<V>(&mut rays[stay..to_near + far_only], far, far_b, depth + 1);
+        }
+    }
+}
