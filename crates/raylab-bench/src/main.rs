@@ -22,6 +22,8 @@ enum Command {
     Render(commands::render::RenderArgs),
     /// Trace the Embree harness's rays with one method and report Mrays/s, checksums and counters.
     Trace(commands::trace::TraceArgs),
+    /// Move objects every frame: kd-tree rebuild, MBVH refit and DACRT (no structure), update + trace times.
+    Animate(commands::animate::AnimateArgs),
     /// Print a scene's contents and kd-tree statistics.
     Info(commands::info::InfoArgs),
     /// Run the Embree harness and raylab on the same view in one go, and print the comparison table.
@@ -38,6 +40,7 @@ fn main() -> std::process::ExitCode {
         None => commands::render::run(&commands::render::RenderArgs::default_scene()),
         Some(Command::Render(a)) => commands::render::run(a),
         Some(Command::Trace(a)) => commands::trace::run(a),
+        Some(Command::Animate(a)) => commands::animate::run(a),
         Some(Command::Info(a)) => commands::info::run(a),
         Some(Command::Compare(a)) => commands::compare::run(a),
         Some(Command::Tables(a)) => commands::tables::run(a),

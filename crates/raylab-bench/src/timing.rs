@@ -15,6 +15,10 @@ use serde::Serialize;
 /// The tile edge the harness uses.
 pub const HARNESS_TILE: u32 = 16;
 
+/// Tile edge of DACRT's ray sets in the benchmarks: 65,536 rays a set, four sets for 512x512 (so two threads
+/// share the work); smaller sets repeat the division of the scene's triangles more often.
+pub const DACRT_SET_TILE: u32 = 256;
+
 /// Per-pixel result of a trace: hit distance (closest-hit kinds) or occlusion.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PixelResult {

@@ -286,3 +286,40 @@ fn distribution_prints_per_bounce_speeds_for_each_method() {
     let o = bench(&["distribution", "--scene", "arena", "--bounces", "9"], dir.path());
     assert!(!o.status.success() && stderr(&o).contains("1..=7"));
 }
+
+#[test]
+fn dacrt_traces_and_animate_reports_every_update_strategy() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = bench(
+        &["trace", "--scene", "kitchen", "--width", "48", "--height", "48", "--kind", "diffuse", "--method", "dacrt"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("validated"));
+    let md = dir.path().join("animate.md");
+    let o = bench(
+        &[
+            "animate",
+            "--scene",
+            "atrium",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--frames",
+            "2",
+            "--markdown",
+            md.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = std::fs::read_to_string(&md).unwrap();
+    for row in ["| mono | kd-tree rebuilt |", "| mbvh | MBVH refitted |", "| dacrt | none (DACRT) |"] {
+        assert!(table.contains(row), "{row} missing from:\n{table}");
+    }
+    let o = bench(&["animate", "--frames", "0"], dir.path());
+    assert!(!o.status.success() && stderr(&o).contains("--frames"), "{}", stderr(&o));
+    let o = bench(&["trace", "--method", "dacrt", "--dacrt-split", "middle"], dir.path());
+    assert!(!o.status.success() && stderr(&o).contains("sah, median"), "{}", stderr(&o));
+}

@@ -2,6 +2,7 @@
 //!
 //! Every source produces a [`raylab_core::scene::Scene`] with at least one view and one light.
 
+pub mod animation;
 pub mod builtin;
 mod error;
 pub mod gltf_model;

@@ -17,11 +17,7 @@ use raylab_core::workload::{RayKind, WorkloadBuilder};
 use crate::args::{KdArgs, SceneArgs, in_range};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene, with_spinner};
-use crate::timing::{HARNESS_TILE, TraceReport, measure, validate};
-
-/// Tile edge of DACRT's ray sets on the diffuse rays: 65,536 rays a set, four sets for 512x512 (so two threads
-/// share the work); smaller sets repeat the division of the scene's triangles more often.
-const DACRT_TILE: u32 = 256;
+use crate::timing::{DACRT_SET_TILE as DACRT_TILE, HARNESS_TILE, TraceReport, measure, validate};
 
 /// Compares raylab's single-ray kd-tree with Embree's single-ray API on the harness's rays.
 #[derive(Args, Debug)]

@@ -1,5 +1,6 @@
 //! The subcommands.
 
+pub mod animate;
 pub mod compare;
 pub mod distribution;
 pub mod info;

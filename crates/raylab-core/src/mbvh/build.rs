@@ -66,13 +66,18 @@ pub fn build(boxes: &[Aabb], centroids: &[Vec3]) -> Built {
 /// rays leaving a surface, whose hits lie at tiny distances) must never cull a box the ray touches.
 const BOX_PAD: f32 = 16.0 * f32::EPSILON;
 
-/// Writes a child's padded box and reference into lane `k` of `node`.
-fn put(node: &mut MbvhNode, k: usize, b: &Aabb, first: u32, count: u32) {
+/// Writes box `b`, padded, into lane `k` of `node`.
+pub(super) fn put_box(node: &mut MbvhNode, k: usize, b: &Aabb) {
     for a in 0..3 {
         let pad = BOX_PAD * b.min[a].abs().max(b.max[a].abs()) + f32::MIN_POSITIVE;
         node.min[a][k] = b.min[a] - pad;
         node.max[a][k] = b.max[a] + pad;
     }
+}
+
+/// Writes a child's padded box and reference into lane `k` of `node`.
+fn put(node: &mut MbvhNode, k: usize, b: &Aabb, first: u32, count: u32) {
+    put_box(node, k, b);
     node.child[k] = first;
     node.count[k] = count;
     node.used |= 1 << k;

@@ -1,12 +1,14 @@
 //! The 4-wide bounding volume hierarchy ("MBVH") of the MBVH RS paper (Tsakok 2009, seed 001): build, node
-//! layout, single-ray traversal and ray stream tracing (MBVH RS).
+//! layout, single-ray traversal, ray stream tracing (MBVH RS) and refitting for moving geometry.
 
 mod build;
 mod node;
+mod refit;
 mod single;
 mod stream;
 
 pub use node::{EMPTY, MbvhNode};
+pub use refit::RefitError;
 
 use std::time::{Duration, Instant};
 

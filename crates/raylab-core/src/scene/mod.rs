@@ -87,6 +87,29 @@ impl Scene {
         [self.positions[t.v[0] as usize], self.positions[t.v[1] as usize], self.positions[t.v[2] as usize]]
     }
 
+    /// Moves vertices, for animation: `positions` replace the positions from vertex `first` on, and `normals`
+    /// (when given and the scene has normals) the normals; the scene's bounds follow. A range past the end or
+    /// a non-finite position is refused with a message, leaving the scene unchanged. Rigid motions keep every
+    /// triangle's area, so the builder's guarantees (finite, non-degenerate triangles) still hold.
+    pub fn set_vertices(&mut self, first: usize, positions: &[Vec3], normals: Option<&[Vec3]>) -> Result<(), String> {
+        let end = first + positions.len();
+        if end > self.positions.len() {
+            return Err(format!("vertices {first}..{end} are past the scene's {}", self.positions.len()));
+        }
+        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+            return Err(format!("non-finite vertex position {p}"));
+        }
+        if let Some(n) = normals.filter(|_| !self.normals.is_empty()) {
+            if n.len() != positions.len() {
+                return Err(format!("{} normals for {} positions", n.len(), positions.len()));
+            }
+            self.normals[first..end].copy_from_slice(n);
+        }
+        self.positions[first..end].copy_from_slice(positions);
+        self.bounds = bounds_of(&self.triangles, &self.positions);
+        Ok(())
+    }
+
     /// Bounds of triangle `i`.
     pub fn triangle_bounds(&self, i: usize) -> Aabb {
         Aabb::from_points(self.vertices(i))
@@ -204,8 +227,7 @@ impl SceneBuilder {
                 }
             }
         }
-        let bounds =
-            self.triangles.iter().flat_map(|t| t.v).fold(Aabb::EMPTY, |b, i| b.grow(self.positions[i as usize]));
+        let bounds = bounds_of(&self.triangles, &self.positions);
         Scene {
             positions: self.positions,
             normals: self.normals,
@@ -219,6 +241,11 @@ impl SceneBuilder {
             bounds,
         }
     }
+}
+
+/// Bounds of the vertices the triangles use.
+fn bounds_of(triangles: &[Triangle], positions: &[Vec3]) -> Aabb {
+    triangles.iter().flat_map(|t| t.v).fold(Aabb::EMPTY, |b, i| b.grow(positions[i as usize]))
 }
 
 #[cfg(test)]
