@@ -30,6 +30,10 @@ pub struct Cli {
     /// Distribution mode: paths per pixel added each frame.
     #[arg(long, default_value_t = 4, value_parser = in_range(1, 256))]
     pub paths_per_pass: u64,
+    /// Move a spinning mirror and a bouncing ball every frame (the kd-tree is rebuilt, the MBVH refitted,
+    /// DACRT needs nothing; the panel shows what each update costs).
+    #[arg(long)]
+    pub animate: bool,
     /// Distribution mode: lens radius of the camera (0: pinhole).
     #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative, allow_hyphen_values = true)]
     pub aperture: f32,

@@ -131,6 +131,8 @@ struct StatsFile<'a> {
     ui_rects: &'a [[f32; 4]],
     /// In distribution mode, the paths per pixel in the last frame.
     paths: Option<u32>,
+    /// With the animation on, the last frame's structure updates.
+    animation: Option<crate::animated::UpdateTimes>,
     readouts: StatsReport,
 }
 
@@ -160,6 +162,7 @@ impl Automation {
                 panel_rect: lab.panel_rect,
                 ui_rects: &lab.ui_rects,
                 paths: latest.paths,
+                animation: latest.animation,
                 readouts: lab.readouts.report(),
             };
             let json = serde_json::to_string_pretty(&file).map_err(|e| e.to_string())?;

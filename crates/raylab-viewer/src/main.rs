@@ -4,6 +4,7 @@
 //! With `--frames N` it renders N traced frames, writes the requested screenshots and readouts, and exits;
 //! `--headless` does the same offscreen when there is no window system.
 
+mod animated;
 mod app;
 mod camera_path;
 mod capture;
@@ -63,6 +64,7 @@ fn run(cli: &Cli) -> Result<(), String> {
         scale: cli.scale as u32,
         threads: cli.thread_count(),
         continuous: true,
+        animate: cli.animate,
     };
     if let Some(why) = settings.method_unavailable(settings.trace.method) {
         return Err(format!("--method {}: {why}", settings.trace.method));

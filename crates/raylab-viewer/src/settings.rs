@@ -87,6 +87,8 @@ pub struct ViewerSettings {
     pub threads: usize,
     /// Keep tracing the same view (to read steady FPS) rather than only after a change.
     pub continuous: bool,
+    /// Move a spinning mirror and a bouncing ball every frame, updating the structures each frame.
+    pub animate: bool,
 }
 
 impl ViewerSettings {

@@ -14,6 +14,12 @@ use raylab_core::scene::{Camera, PointLight};
 use raylab_core::stats::TraversalStats;
 use raylab_core::trace::Tracer;
 
+use raylab_core::dacrt::Dacrt;
+use raylab_core::kdtree::KdTree;
+use raylab_core::mbvh::Mbvh;
+use raylab_core::scene::Scene;
+
+use crate::animated::{AnimatedScene, UpdateTimes};
 use crate::compare::{CompareRow, compare_configs};
 use crate::loader::LoadedScene;
 use crate::settings::{RenderMode, ViewerSettings};
@@ -43,6 +49,34 @@ pub struct Rendered {
     pub settings: ViewerSettings,
     /// In distribution mode, the paths per pixel accumulated in the image.
     pub paths: Option<u32>,
+    /// With the animation on, what bringing the structures up to date cost before this frame.
+    pub animation: Option<UpdateTimes>,
+}
+
+/// The scene and structures a frame traces: the loaded ones, or the animated copies.
+pub struct Structures<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Its kd-tree.
+    pub tree: &'a KdTree,
+    /// Its MBVH.
+    pub mbvh: &'a Mbvh,
+    /// DACRT's triangle copy.
+    pub dacrt: &'a Dacrt,
+}
+
+impl LoadedScene {
+    /// The loaded scene's structures.
+    pub fn structures(&self) -> Structures<'_> {
+        Structures { scene: &self.scene, tree: &self.tree, mbvh: &self.mbvh, dacrt: &self.dacrt }
+    }
+}
+
+impl AnimatedScene {
+    /// The animated scene's structures.
+    pub fn structures(&self) -> Structures<'_> {
+        Structures { scene: &self.scene, tree: &self.tree, mbvh: &self.mbvh, dacrt: &self.dacrt }
+    }
 }
 
 /// The distribution mode's image in progress and the view it belongs to.
@@ -173,6 +207,7 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
     lower_priority();
     let mut pool: Option<(usize, rayon::ThreadPool)> = None;
     let mut progressive: Option<Progressive> = None;
+    let mut animated: Option<AnimatedScene> = None;
     loop {
         let task = {
             let mut st = shared.lock();
@@ -206,22 +241,57 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
             }
         }
         let Some((_, pool)) = pool.as_ref() else { continue };
+        // With the animation on, move the objects and update the structures this frame traces.
+        let update = match &task {
+            Task::Frame(job) if job.settings.animate => {
+                if !animated.as_ref().is_some_and(|a| a.animates(&job.scene)) {
+                    animated = match pool.install(|| AnimatedScene::new(&job.scene)) {
+                        Ok(a) => Some(a),
+                        Err(e) => {
+                            shared.lock().repeat = None;
+                            send(tx, wake, WorkerEvent::Error(e));
+                            continue;
+                        }
+                    };
+                }
+                let Some(a) = animated.as_mut() else { continue };
+                match pool.install(|| a.step(&job.settings)) {
+                    Ok(u) => Some(u),
+                    Err(e) => {
+                        shared.lock().repeat = None;
+                        send(tx, wake, WorkerEvent::Error(e));
+                        continue;
+                    }
+                }
+            }
+            _ => {
+                animated = None;
+                None
+            }
+        };
+        let moving = animated.as_ref().filter(|_| update.is_some());
         match task {
             Task::Frame(job) if job.settings.mode == RenderMode::Distribution => {
-                if !progressive.as_ref().is_some_and(|p| p.same_view(&job)) {
+                // Moving geometry starts the image afresh every frame.
+                if moving.is_some() || !progressive.as_ref().is_some_and(|p| p.same_view(&job)) {
                     let acc = Accumulator::new(job.size.0.max(1), job.size.1.max(1));
                     progressive = Some(Progressive { job: job.clone(), acc, passes: 0 });
                 }
                 let Some(p) = progressive.as_mut() else { continue };
-                let rendered = pool.install(|| distribution_pass(p));
+                let s = moving.map_or_else(|| job.scene.structures(), AnimatedScene::structures);
+                let mut rendered = pool.install(|| distribution_pass(p, &s));
+                rendered.animation = update;
                 // Keep refining while the view stays, up to the pass limit.
                 let more = p.passes < job.settings.distribution.max_passes.max(1);
-                shared.lock().repeat = (more || job.settings.continuous).then(|| job.clone());
+                let again = more || job.settings.continuous || job.settings.animate;
+                shared.lock().repeat = again.then(|| job.clone());
                 send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
             }
             Task::Frame(job) => {
-                let rendered = pool.install(|| trace_frame(&job, job.settings.trace.method));
-                shared.lock().repeat = job.settings.continuous.then(|| job.clone());
+                let s = moving.map_or_else(|| job.scene.structures(), AnimatedScene::structures);
+                let mut rendered = pool.install(|| trace_in(&s, &job, job.settings.trace.method));
+                rendered.animation = update;
+                shared.lock().repeat = (job.settings.continuous || job.settings.animate).then(|| job.clone());
                 send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
             }
             Task::Compare(job) => {
@@ -245,30 +315,33 @@ fn send(tx: &Sender<WorkerEvent>, wake: &dyn Fn(), ev: WorkerEvent) {
     wake();
 }
 
-/// Traces `job` with `method` on the current rayon pool.
+/// Traces `job` with `method` on the current rayon pool, in the loaded scene.
 pub fn trace_frame(job: &Job, method: Method) -> Rendered {
-    let s = &job.scene;
-    let settings = job.settings.render_settings(job.size.0, job.size.1);
-    let tracer = Tracer::new(&s.tree, None, raylab_core::trace::TraceOptions { method, ..job.settings.trace })
-        .with_mbvh(&s.mbvh)
-        .with_dacrt(&s.dacrt);
-    let t0 = Instant::now();
-    let frame = render(&s.scene, &tracer, &job.camera, job.light, &settings);
-    Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings, paths: None }
+    trace_in(&job.scene.structures(), job, method)
 }
 
-/// Adds one distribution pass to `p` on the current rayon pool and returns the refined image.
-fn distribution_pass(p: &mut Progressive) -> Rendered {
+/// Traces `job` with `method` in the scene and structures `s`.
+fn trace_in(s: &Structures, job: &Job, method: Method) -> Rendered {
+    let settings = job.settings.render_settings(job.size.0, job.size.1);
+    let tracer = Tracer::new(s.tree, None, raylab_core::trace::TraceOptions { method, ..job.settings.trace })
+        .with_mbvh(s.mbvh)
+        .with_dacrt(s.dacrt);
+    let t0 = Instant::now();
+    let frame = render(s.scene, &tracer, &job.camera, job.light, &settings);
+    Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings, paths: None, animation: None }
+}
+
+/// Adds one distribution pass, traced in `s`, to `p` on the current rayon pool and returns the refined image.
+fn distribution_pass(p: &mut Progressive, s: &Structures) -> Rendered {
     let job = &p.job;
-    let s = &job.scene;
     let (w, h) = (p.acc.width, p.acc.height);
     let settings = job.settings.distribution.settings(w, h, job.settings.tile);
-    let tracer = Tracer::new(&s.tree, None, job.settings.trace).with_mbvh(&s.mbvh).with_dacrt(&s.dacrt);
+    let tracer = Tracer::new(s.tree, None, job.settings.trace).with_mbvh(s.mbvh).with_dacrt(s.dacrt);
     let mut camera = job.camera;
     camera.aperture = job.settings.distribution.aperture;
     let light = job.light.soft();
     let t0 = Instant::now();
-    let bounces = render_pass(&s.scene, &tracer, &camera, light, &settings, p.passes, &mut p.acc);
+    let bounces = render_pass(s.scene, &tracer, &camera, light, &settings, p.passes, &mut p.acc);
     p.passes += 1;
     let mut stats = TraversalStats::default();
     let mut stages = StageTimes::default();
@@ -282,5 +355,11 @@ fn distribution_pass(p: &mut Progressive) -> Rendered {
         stages.shadow += b.shadow_seconds;
     }
     let frame = Frame { width: w, height: h, rgba: p.acc.rgba(), stats, stages, range: None };
-    Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings, paths: Some(p.acc.paths) }
+    Rendered {
+        frame,
+        wall_s: t0.elapsed().as_secs_f64(),
+        settings: job.settings,
+        paths: Some(p.acc.paths),
+        animation: None,
+    }
 }

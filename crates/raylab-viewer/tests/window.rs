@@ -214,3 +214,32 @@ fn distribution_mode_shows_the_accumulated_passes() {
     let want = image::RgbaImage::from_raw(W, H, acc.rgba().as_flattened().to_vec()).unwrap();
     check("distribution", &shot, &stats, &want);
 }
+
+/// The animation switch: objects move between frames, and each method updates only its own structure (the
+/// kd-tree methods rebuild, the MBVH methods refit, DACRT copies triangles), in both render modes.
+#[test]
+fn animation_moves_objects_and_updates_the_structure_each_method_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, &[&str], [bool; 3]); 4] = [
+        ("anim-mono", &["--method", "mono"], [true, false, false]),
+        ("anim-mbvh", &["--method", "mbvh", "--shadows", "cached"], [false, true, false]),
+        ("anim-dacrt", &["--method", "dacrt"], [false, false, true]),
+        ("anim-dist-dacrt", &["--method", "dacrt", "--mode", "distribution"], [false, false, true]),
+    ];
+    for (name, args, [kd, refit, dacrt]) in cases {
+        let mut all = vec!["--animate"];
+        all.extend_from_slice(args);
+        let (shot, stats) = run_viewer(dir.path(), name, true, &all);
+        let a = &stats["animation"];
+        assert!(a["moving_triangles"].as_u64().unwrap() > 100, "{name}: {a}");
+        assert!(a["time_s"].as_f64().unwrap() > 0.0, "{name}: {a}");
+        assert_eq!(a["kd_rebuild_ms"].is_number(), kd, "{name}: {a}");
+        assert_eq!(a["mbvh_refit_ms"].is_number(), refit, "{name}: {a}");
+        assert_eq!(a["dacrt_setup_ms"].is_number(), dacrt, "{name}: {a}");
+        assert_eq!(stats["settings"]["animate"], true);
+        assert!(shot.pixels().any(|p| p.0[0] > 40), "{name}: the frame is not black");
+    }
+    // Without the switch there is nothing to report.
+    let (_, stats) = run_viewer(dir.path(), "still", true, &["--method", "dacrt"]);
+    assert!(stats["animation"].is_null());
+}

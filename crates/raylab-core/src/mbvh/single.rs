@@ -108,6 +108,13 @@ impl Mbvh {
         best
     }
 
+    /// True when triangle `tri` blocks `ray` (the shadow cache's test).
+    pub fn blocks(&self, ray: &Ray, tri: u32) -> bool {
+        ray.is_valid()
+            && (tri as usize) < self.tris.len()
+            && RayShear::new(ray).intersect(self.tris.get(tri), ray.tmin, ray.tmax).is_some()
+    }
+
     /// The first blocker found along `ray` (not necessarily the nearest), for the shadow cache.
     pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         match self.backend {

@@ -146,6 +146,7 @@ impl<'a> Tracer<'a> {
         match self.options.method {
             Method::Reference => self.reference().blocks(ray, tri),
             Method::Dacrt => self.dacrt().blocks(ray, tri),
+            Method::Mbvh | Method::MbvhRs => self.mbvh().blocks(ray, tri),
             _ => self.tree.blocks(ray, tri),
         }
     }

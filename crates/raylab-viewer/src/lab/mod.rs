@@ -524,6 +524,7 @@ mod tests {
             scale: 100,
             threads: 2,
             continuous: false,
+            animate: false,
         };
         Lab::new(scene, kd, settings, Arc::new(|| {}))
     }

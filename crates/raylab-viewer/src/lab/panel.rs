@@ -7,6 +7,7 @@ use raylab_core::render::{FrameView, RayOrder};
 use raylab_simd::Backend;
 
 use super::{Lab, Shot};
+use crate::animated::UpdateTimes;
 use crate::camera_path::CameraPath;
 use crate::cli::value_name;
 use raylab_core::render::RenderSettings;
@@ -158,6 +159,7 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
     let before = lab.settings;
     let light_radius = lab.light.radius;
     let paths = lab.latest().and_then(|r| r.paths);
+    let animation = lab.latest().and_then(|r| r.animation);
     let s = &mut lab.settings;
     egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| {
         egui::ComboBox::from_label("mode").selected_text(value_name(&s.mode)).show_ui(ui, |ui| {
@@ -230,6 +232,11 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
         ui.add(egui::Slider::new(&mut s.threads, 1..=(2 * cpus).max(2)).text("threads"));
         ui.add(egui::Slider::new(&mut s.scale, 25..=100).text("render scale %"));
         ui.checkbox(&mut s.continuous, "trace continuously").on_hover_text("keep tracing a still view for steady FPS");
+        ui.checkbox(&mut s.animate, "animate (spinning mirror, bouncing ball)")
+            .on_hover_text("move objects every frame: the kd-tree is rebuilt, the MBVH refitted, DACRT needs nothing");
+        if let Some(u) = animation.filter(|_| s.animate) {
+            animation_readout(ui, &u);
+        }
     });
     if lab.settings != before {
         lab.dirty = true;
@@ -331,4 +338,18 @@ fn dacrt_controls(ui: &mut egui::Ui, s: &mut ViewerSettings) {
     if edge != s.tile {
         ui.small(format!("DACRT traces {edge}x{edge} tiles: smaller ray sets repeat the division of every triangle"));
     }
+}
+
+/// What the last frame's structure updates cost.
+fn animation_readout(ui: &mut egui::Ui, u: &UpdateTimes) {
+    let part = |name: &str, ms: Option<f64>| ms.map(|ms| format!("{name} {ms:.1} ms"));
+    let parts: Vec<String> = [
+        part("kd-tree rebuild", u.kd_rebuild_ms),
+        part("MBVH refit", u.mbvh_refit_ms),
+        part("DACRT setup", u.dacrt_setup_ms),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    ui.small(format!("t = {:.1} s, {} moving triangles: {}", u.time_s, u.moving_triangles, parts.join(", ")));
 }
