@@ -3,6 +3,7 @@
 //! fixed-function materials, reflections and refractions included ([`shade`]), or drawn as one of the
 //! diagnostic [`FrameView`]s.
 
+pub mod hybrid;
 mod order;
 pub mod shade;
 mod stages;

@@ -137,6 +137,23 @@ impl CameraRaster {
         Ray::new(origin, (focus - origin).normalize())
     }
 
+    /// The matrix that takes a world point `(x, y, z, 1)` to the clip space of a rasteriser (wgpu/WebGPU: x and
+    /// y in [-1, 1] with y up, depth in [0, 1)), so that a rasterised pixel centre sees exactly what
+    /// [`CameraRaster::primary`] sees there (the hybrid mode's G-buffer, seed 003). Column-major, as WGSL's
+    /// `mat4x4<f32>` expects. Depth is `1 - near / distance along the view axis` (an infinite far plane).
+    pub fn clip_matrix(&self, near: f32) -> [[f32; 4]; 4] {
+        let (r, u, f) = (self.r / self.r.length_squared(), self.u / self.u.length_squared(), self.f);
+        let e = self.eye.as_dvec3();
+        // Rows: x = r'.(p - e), y = u'.(p - e), z = f.(p - e) - near, w = f.(p - e).
+        let rows = [
+            [r.x, r.y, r.z, -r.dot(e)],
+            [u.x, u.y, u.z, -u.dot(e)],
+            [f.x, f.y, f.z, -f.dot(e) - near as f64],
+            [f.x, f.y, f.z, -f.dot(e)],
+        ];
+        std::array::from_fn(|col| std::array::from_fn(|row| rows[row][col] as f32))
+    }
+
     /// The primary ray through the centre of pixel `(x, y)`.
     pub fn primary(&self, x: u32, y: u32) -> Ray {
         self.primary_at(x as f64 + 0.5, y as f64 + 0.5)
@@ -154,6 +171,30 @@ impl CameraRaster {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_clip_matrix_puts_points_on_the_pixels_whose_rays_see_them() {
+        let cam = Camera {
+            eye: Vec3::new(1.0, 2.0, 3.0),
+            target: Vec3::new(-4.0, 0.5, 9.0),
+            up: Vec3::Y,
+            vfov_deg: 55.0,
+            aperture: 0.0,
+            focus_distance: 1.0,
+        };
+        let (w, h) = (64u32, 48u32);
+        let raster = cam.raster(w, h);
+        let m = raster.clip_matrix(0.01);
+        for (x, y, t) in [(0, 0, 2.0), (63, 47, 7.5), (20, 31, 30.0), (32, 24, 0.5)] {
+            let p = raster.primary(x, y).at(t);
+            let clip: [f32; 4] = std::array::from_fn(|row| (0..4).map(|c| m[c][row] * [p.x, p.y, p.z, 1.0][c]).sum());
+            let (nx, ny, nz) = (clip[0] / clip[3], clip[1] / clip[3], clip[2] / clip[3]);
+            // NDC to framebuffer: y down, pixel centres at +0.5.
+            let (fx, fy) = ((nx + 1.0) * 0.5 * w as f32, (1.0 - ny) * 0.5 * h as f32);
+            assert!((fx - (x as f32 + 0.5)).abs() < 1e-3 && (fy - (y as f32 + 0.5)).abs() < 1e-3, "{fx} {fy}");
+            assert!((0.0..1.0).contains(&nz), "depth {nz}");
+        }
+    }
 
     #[test]
     fn centre_ray_looks_at_target() {
