@@ -21,7 +21,8 @@ pub struct Cli {
     pub method: MethodArgs,
     #[command(flatten)]
     pub shade: ShadeArgs,
-    /// Render mode: whitted, or distribution (glossy paths, soft shadows, depth of field, refined over frames).
+    /// Render mode: whitted, distribution (glossy paths, soft shadows, depth of field, refined over frames), or
+    /// hybrid (GPU G-buffer, CPU-traced reflections, GPU composite).
     #[arg(long, value_enum, default_value_t = RenderMode::Whitted)]
     pub mode: RenderMode,
     /// Distribution mode: bounces after the primary hit.
@@ -30,6 +31,18 @@ pub struct Cli {
     /// Distribution mode: paths per pixel added each frame.
     #[arg(long, default_value_t = 4, value_parser = in_range(1, 256))]
     pub paths_per_pass: u64,
+    /// Hybrid mode: G-buffer resolution in percent of the render resolution (25, 50 or 100).
+    #[arg(long, default_value_t = 50, value_parser = one_of(&[25, 50, 100]))]
+    pub gbuffer_percent: u64,
+    /// Hybrid mode: trace every row of reflections each frame (1), or every second (2) or fourth (4) in turn.
+    #[arg(long, default_value_t = 1, value_parser = one_of(&[1, 2, 4]))]
+    pub interlace: u64,
+    /// Hybrid mode: wait for each frame's G-buffer instead of reading it back asynchronously.
+    #[arg(long)]
+    pub sync_readback: bool,
+    /// Hybrid mode: the method that traces the reflection rays.
+    #[arg(long, default_value = "dacrt")]
+    pub hybrid_method: raylab_core::method::Method,
     /// Move a spinning mirror and a bouncing ball every frame (the kd-tree is rebuilt, the MBVH refitted,
     /// DACRT needs nothing; the panel shows what each update costs).
     #[arg(long)]
@@ -100,6 +113,12 @@ impl Cli {
                 }
             }
         }
+        if self.hybrid_method == raylab_core::method::Method::Reference {
+            return Err("--hybrid-method reference: brute force is for tests, far too slow to fly with".into());
+        }
+        if self.animate && self.mode == RenderMode::Hybrid {
+            return Err("--animate: the hybrid mode rasterises the loaded scene, which does not move yet".into());
+        }
         Ok(())
     }
 
@@ -112,4 +131,17 @@ impl Cli {
 /// `ValueEnum` names for the menus and the command line are the same strings.
 pub fn value_name<T: ValueEnum>(v: &T) -> String {
     v.to_possible_value().map(|p| p.get_name().to_string()).unwrap_or_default()
+}
+
+/// A parser accepting only the listed values; the error lists them.
+fn one_of(allowed: &'static [u64]) -> impl Fn(&str) -> Result<u64, String> + Clone {
+    move |s| {
+        let v: u64 = s.trim().parse().map_err(|_| format!("'{s}' is not a whole number"))?;
+        if allowed.contains(&v) {
+            Ok(v)
+        } else {
+            let list: Vec<String> = allowed.iter().map(u64::to_string).collect();
+            Err(format!("{v} is not one of {}", list.join(", ")))
+        }
+    }
 }

@@ -3,6 +3,9 @@
 
 use std::time::{Duration, Instant};
 
+/// Format of the frame texture: display-ready 8-bit values.
+pub const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
 /// Size of the uniform block of `frame.wgsl` (target size and padding).
 const PARAMS_BYTES: u64 = 16;
 
@@ -107,28 +110,7 @@ impl Compositor {
         if rgba.len() != (width as usize) * (height as usize) || width == 0 || height == 0 {
             return t0.elapsed();
         }
-        if self.frame.as_ref().is_none_or(|f| f.size != (width, height)) {
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("traced frame"),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba8Unorm,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("traced frame"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                    wgpu::BindGroupEntry { binding: 1, resource: self.params.as_entire_binding() },
-                ],
-            });
-            self.frame = Some(FrameTexture { texture, bind_group, size: (width, height) });
-        }
+        self.ensure_frame(device, (width, height));
         if let Some(f) = &self.frame {
             let bytes: &[u8] = rgba.as_flattened();
             queue.write_texture(
@@ -144,6 +126,46 @@ impl Compositor {
             );
         }
         t0.elapsed()
+    }
+
+    /// The frame texture as a render target of `size` pixels (made or resized as needed): the hybrid mode's
+    /// composite pass draws into it instead of uploading a traced frame.
+    pub fn frame_target(&mut self, device: &wgpu::Device, size: (u32, u32)) -> wgpu::TextureView {
+        let size = (size.0.max(1), size.1.max(1));
+        self.ensure_frame(device, size);
+        match &self.frame {
+            Some(f) => f.texture.create_view(&wgpu::TextureViewDescriptor::default()),
+            None => unreachable!("ensure_frame made the frame texture"),
+        }
+    }
+
+    /// Makes the frame texture (and its bind group) when there is none of `size` pixels.
+    fn ensure_frame(&mut self, device: &wgpu::Device, (width, height): (u32, u32)) {
+        if self.frame.as_ref().is_some_and(|f| f.size == (width, height)) {
+            return;
+        }
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("traced frame"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: FRAME_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("traced frame"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
+                wgpu::BindGroupEntry { binding: 1, resource: self.params.as_entire_binding() },
+            ],
+        });
+        self.frame = Some(FrameTexture { texture, bind_group, size: (width, height) });
     }
 
     /// Applies egui's texture changes of a UI frame: new and updated textures now, and returns the ones to

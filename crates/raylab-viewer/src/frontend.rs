@@ -9,7 +9,9 @@ use serde::Serialize;
 use crate::capture::capture;
 use crate::compositor::Compositor;
 use crate::gpu::Gpu;
+use crate::hybrid::HybridGpu;
 use crate::lab::{Lab, StatsReport};
+use crate::settings::RenderMode;
 
 /// The GPU side of the viewer.
 pub struct Frontend {
@@ -19,6 +21,8 @@ pub struct Frontend {
     pub compositor: Compositor,
     /// egui's context.
     pub egui: egui::Context,
+    /// The hybrid mode's passes, made when the mode is first used.
+    hybrid: Option<HybridGpu>,
     last_tick: Instant,
 }
 
@@ -42,7 +46,7 @@ impl Frontend {
     /// The GPU side for targets of `format`.
     pub fn new(gpu: Gpu, format: wgpu::TextureFormat) -> Self {
         let compositor = Compositor::new(&gpu.device, format);
-        Self { gpu, compositor, egui: egui::Context::default(), last_tick: Instant::now() }
+        Self { gpu, compositor, egui: egui::Context::default(), hybrid: None, last_tick: Instant::now() }
     }
 
     /// Advances `lab`, uploads its newest traced frame and runs the UI for a target of `size` pixels.
@@ -52,11 +56,25 @@ impl Frontend {
         self.last_tick = started;
         lab.set_window_size(size.0, size.1);
         lab.tick(dt);
-        let upload_ms = lab.poll().map(|r| {
-            let f = &r.frame;
-            let d = self.compositor.upload(&self.gpu.device, &self.gpu.queue, f.width, f.height, &f.rgba);
-            d.as_secs_f64() * 1e3
-        });
+        if lab.settings.mode == RenderMode::Hybrid {
+            self.hybrid.get_or_insert_with(|| HybridGpu::new(&self.gpu.device)).step(&self.gpu, lab);
+        }
+        let fresh = lab.poll().map(|r| (r.hybrid.clone(), r.frame.width, r.frame.height));
+        let upload_ms = match fresh {
+            Some((Some(h), _, _)) => {
+                let shown = self.hybrid.as_mut().and_then(|g| g.show(&self.gpu, &mut self.compositor, &h, lab));
+                lab.hybrid_gpu_ms = shown;
+                shown.map(|(upload, composite)| upload + composite)
+            }
+            Some((None, w, h)) => {
+                let f = lab.latest().map(|r| &r.frame).filter(|f| (f.width, f.height) == (w, h));
+                f.map(|f| {
+                    let d = self.compositor.upload(&self.gpu.device, &self.gpu.queue, f.width, f.height, &f.rgba);
+                    d.as_secs_f64() * 1e3
+                })
+            }
+            None => None,
+        };
         let out = self.egui.run_ui(raw, |ui| lab.ui(ui));
         let jobs = self.egui.tessellate(out.shapes, out.pixels_per_point);
         let free = self.compositor.apply_egui_textures(&self.gpu.device, &self.gpu.queue, out.textures_delta);
@@ -133,7 +151,22 @@ struct StatsFile<'a> {
     paths: Option<u32>,
     /// With the animation on, the last frame's structure updates.
     animation: Option<crate::animated::UpdateTimes>,
+    /// In hybrid mode, the last frame's G-buffer and costs.
+    hybrid: Option<HybridStats>,
     readouts: StatsReport,
+}
+
+/// The hybrid mode's part of the `--json-stats` file.
+#[derive(Serialize)]
+struct HybridStats {
+    gbuffer: [u32; 2],
+    reflective_pixels: usize,
+    rays: usize,
+    raster_ms: f64,
+    readback_ms: f64,
+    trace_ms: f64,
+    upload_ms: Option<f64>,
+    composite_ms: Option<f64>,
 }
 
 impl Automation {
@@ -163,6 +196,16 @@ impl Automation {
                 ui_rects: &lab.ui_rects,
                 paths: latest.paths,
                 animation: latest.animation,
+                hybrid: latest.hybrid.as_ref().map(|h| HybridStats {
+                    gbuffer: [h.size.0, h.size.1],
+                    reflective_pixels: h.reflective,
+                    rays: h.rays,
+                    raster_ms: h.raster_ms,
+                    readback_ms: h.readback_ms,
+                    trace_ms: h.trace_ms,
+                    upload_ms: lab.hybrid_gpu_ms.map(|m| m.0),
+                    composite_ms: lab.hybrid_gpu_ms.map(|m| m.1),
+                }),
                 readouts: lab.readouts.report(),
             };
             let json = serde_json::to_string_pretty(&file).map_err(|e| e.to_string())?;

@@ -15,6 +15,7 @@ mod fly;
 mod frontend;
 mod gpu;
 mod headless;
+mod hybrid;
 mod lab;
 mod loader;
 mod settings;
@@ -57,6 +58,12 @@ fn run(cli: &Cli) -> Result<(), String> {
             paths_per_pass: cli.paths_per_pass as u32,
             aperture: cli.aperture,
             ..Default::default()
+        },
+        hybrid: crate::settings::HybridControls {
+            gbuffer_percent: cli.gbuffer_percent as u32,
+            interlace: cli.interlace as u32,
+            async_readback: !cli.sync_readback,
+            method: cli.hybrid_method,
         },
         order: cli.order,
         show: cli.show,

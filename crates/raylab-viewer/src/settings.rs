@@ -20,6 +20,41 @@ pub enum RenderMode {
     /// The MBVH RS paper's distribution ray tracer: glossy paths, soft shadows, depth of field, refined
     /// progressively while the view stays still.
     Distribution,
+    /// Stokes's G-buffer ray tracing (seed 003): the GPU rasterises a G-buffer, the CPU traces only the
+    /// reflection rays of reflective pixels, and a GPU pass composites them into the lit raster image.
+    Hybrid,
+}
+
+/// The hybrid mode's controls.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct HybridControls {
+    /// G-buffer (and R-buffer) resolution in percent of the render resolution: 25, 50 or 100.
+    pub gbuffer_percent: u32,
+    /// Reflection rows traced per frame: every row (1), every second (2) or every fourth (4), in turn.
+    pub interlace: u32,
+    /// Read the G-buffer back asynchronously (one frame late, no waiting) rather than waiting for it.
+    pub async_readback: bool,
+    /// The method that traces the reflection rays.
+    pub method: Method,
+}
+
+impl Default for HybridControls {
+    fn default() -> Self {
+        Self { gbuffer_percent: 50, interlace: 1, async_readback: true, method: Method::Dacrt }
+    }
+}
+
+impl HybridControls {
+    /// G-buffer resolutions offered, in percent.
+    pub const PERCENTS: [u32; 3] = [25, 50, 100];
+    /// Interlacing factors offered.
+    pub const INTERLACE: [u32; 3] = [1, 2, 4];
+
+    /// The G-buffer size for a render resolution of `width x height` (at least 1x1).
+    pub fn gbuffer_size(&self, width: u32, height: u32) -> (u32, u32) {
+        let p = self.gbuffer_percent.clamp(1, 100);
+        ((width * p).div_ceil(100).max(1), (height * p).div_ceil(100).max(1))
+    }
 }
 
 /// The distribution ray tracer's controls.
@@ -75,6 +110,8 @@ pub struct ViewerSettings {
     pub depth: u32,
     /// Distribution-mode controls.
     pub distribution: DistributionControls,
+    /// Hybrid-mode controls.
+    pub hybrid: HybridControls,
     /// Pixel order of single-ray methods.
     pub order: RayOrder,
     /// What the traced image shows.

@@ -19,8 +19,14 @@ use raylab_core::kdtree::KdTree;
 use raylab_core::mbvh::Mbvh;
 use raylab_core::scene::Scene;
 
+use raylab_core::ray::Ray;
+use raylab_core::render::hybrid::{reflection_ray, shade_reflections};
+use raylab_core::render::shade::to_display;
+use raylab_core::render::surface_epsilon;
+
 use crate::animated::{AnimatedScene, UpdateTimes};
 use crate::compare::{CompareRow, compare_configs};
+use crate::hybrid::readback::GBufferImage;
 use crate::loader::LoadedScene;
 use crate::settings::{RenderMode, ViewerSettings};
 
@@ -51,6 +57,43 @@ pub struct Rendered {
     pub paths: Option<u32>,
     /// With the animation on, what bringing the structures up to date cost before this frame.
     pub animation: Option<UpdateTimes>,
+    /// In hybrid mode, the R-buffer and what making it cost.
+    pub hybrid: Option<Box<HybridFrame>>,
+}
+
+/// A G-buffer read back from the GPU, whose reflections the worker traces (hybrid mode).
+pub struct ReflectionJob {
+    /// The view it was rasterised from (its size is the G-buffer's).
+    pub job: Job,
+    /// The G-buffer.
+    pub gbuffer: GBufferImage,
+    /// CPU milliseconds spent recording and submitting the raster pass.
+    pub raster_ms: f64,
+    /// CPU milliseconds spent reading the G-buffer back: waiting for the GPU (synchronous readback) and
+    /// unpacking the staging buffers.
+    pub readback_ms: f64,
+}
+
+/// What the hybrid mode's CPU part made of a G-buffer.
+#[derive(Clone, Debug)]
+pub struct HybridFrame {
+    /// R-buffer size (the G-buffer's).
+    pub size: (u32, u32),
+    /// Linear reflection colour per pixel (black where nothing reflects); rows not traced this frame keep the
+    /// previous frame's colours when interlacing.
+    pub rbuffer: Vec<[f32; 4]>,
+    /// The camera position of the G-buffer.
+    pub eye: glam::Vec3,
+    /// Pixels that show a reflective surface.
+    pub reflective: usize,
+    /// Reflection rays traced this frame.
+    pub rays: usize,
+    /// CPU milliseconds recording and submitting the raster pass.
+    pub raster_ms: f64,
+    /// CPU milliseconds reading the G-buffer back (waiting, with synchronous readback, and unpacking).
+    pub readback_ms: f64,
+    /// Milliseconds building, tracing and shading the reflection rays.
+    pub trace_ms: f64,
 }
 
 /// The scene and structures a frame traces: the loaded ones, or the animated copies.
@@ -113,6 +156,7 @@ pub enum WorkerEvent {
 enum Task {
     Frame(Job),
     Compare(Job),
+    Reflections(Box<ReflectionJob>),
 }
 
 #[derive(Default)]
@@ -158,6 +202,15 @@ impl Worker {
     /// Asks for `job` to be traced next, replacing any request not yet started.
     pub fn request(&self, job: Job) {
         self.shared.lock().next = Some(Task::Frame(job));
+        self.shared.wake_worker.notify_one();
+    }
+
+    /// Asks for the reflections of a G-buffer (hybrid mode), replacing any request not yet started.
+    pub fn reflections(&self, job: ReflectionJob) {
+        let mut st = self.shared.lock();
+        st.repeat = None;
+        st.next = Some(Task::Reflections(Box::new(job)));
+        drop(st);
         self.shared.wake_worker.notify_one();
     }
 
@@ -208,6 +261,7 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
     let mut pool: Option<(usize, rayon::ThreadPool)> = None;
     let mut progressive: Option<Progressive> = None;
     let mut animated: Option<AnimatedScene> = None;
+    let mut rbuffer = Interlaced::default();
     loop {
         let task = {
             let mut st = shared.lock();
@@ -226,6 +280,7 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
         };
         let job = match &task {
             Task::Frame(j) | Task::Compare(j) => j,
+            Task::Reflections(r) => &r.job,
         };
         let threads = job.settings.threads.max(1);
         if pool.as_ref().is_none_or(|(n, _)| *n != threads) {
@@ -294,6 +349,10 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
                 shared.lock().repeat = (job.settings.continuous || job.settings.animate).then(|| job.clone());
                 send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
             }
+            Task::Reflections(r) => {
+                let rendered = pool.install(|| reflections(&r, &mut rbuffer));
+                send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
+            }
             Task::Compare(job) => {
                 let configs = compare_configs(job.settings.tile);
                 for (method, tile) in &configs {
@@ -315,6 +374,68 @@ fn send(tx: &Sender<WorkerEvent>, wake: &dyn Fn(), ev: WorkerEvent) {
     wake();
 }
 
+/// The R-buffer kept from frame to frame for interlacing, and which rows come next.
+#[derive(Default)]
+struct Interlaced {
+    size: (u32, u32),
+    colors: Vec<[f32; 4]>,
+    phase: u32,
+}
+
+/// Traces and shades the reflection rays of `r`'s G-buffer on the current rayon pool: every row, or every
+/// k-th row in turn when interlacing (the other rows keep the previous frame's reflections).
+fn reflections(r: &ReflectionJob, kept: &mut Interlaced) -> Rendered {
+    let t0 = Instant::now();
+    let job = &r.job;
+    let g = &r.gbuffer;
+    let s = job.scene.structures();
+    let (w, h) = (g.width, g.height);
+    let k = job.settings.hybrid.interlace.max(1);
+    if kept.size != (w, h) || kept.colors.len() != g.pixels.len() {
+        *kept = Interlaced { size: (w, h), colors: vec![[0.0, 0.0, 0.0, 1.0]; g.pixels.len()], phase: 0 };
+    }
+    let phase = kept.phase % k;
+    kept.phase = kept.phase.wrapping_add(1);
+    let eps = surface_epsilon(s.scene);
+    let traced_row = |i: usize| (i / w as usize) as u32 % k == phase;
+    let rays: Vec<Option<Ray>> = g
+        .pixels
+        .iter()
+        .enumerate()
+        .map(|(i, p)| if traced_row(i) { reflection_ray(job.camera.eye, p, eps) } else { None })
+        .collect();
+    let settings = job.settings.render_settings(w, h);
+    let options = raylab_core::trace::TraceOptions { method: job.settings.hybrid.method, ..job.settings.trace };
+    let tracer = Tracer::new(s.tree, None, options).with_mbvh(s.mbvh).with_dacrt(s.dacrt);
+    let (colors, stats, stages) = shade_reflections(s.scene, &tracer, &job.camera, job.light, &settings, &rays);
+    for (i, c) in colors.iter().enumerate() {
+        if traced_row(i) {
+            kept.colors[i] = [c.x, c.y, c.z, 1.0];
+        }
+    }
+    let rgba = kept.colors.iter().map(|c| [to_display(c[0]), to_display(c[1]), to_display(c[2]), 255]).collect();
+    let trace_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let frame = Frame { width: w, height: h, rgba, stats, stages, range: None };
+    let hybrid = HybridFrame {
+        size: (w, h),
+        rbuffer: kept.colors.clone(),
+        eye: job.camera.eye,
+        reflective: g.pixels.iter().filter(|p| p.material.is_some() && p.reflect > 0.0).count(),
+        rays: rays.iter().filter(|r| r.is_some()).count(),
+        raster_ms: r.raster_ms,
+        readback_ms: r.readback_ms,
+        trace_ms,
+    };
+    Rendered {
+        frame,
+        wall_s: (r.raster_ms + r.readback_ms + trace_ms) / 1e3,
+        settings: job.settings,
+        paths: None,
+        animation: None,
+        hybrid: Some(Box::new(hybrid)),
+    }
+}
+
 /// Traces `job` with `method` on the current rayon pool, in the loaded scene.
 pub fn trace_frame(job: &Job, method: Method) -> Rendered {
     trace_in(&job.scene.structures(), job, method)
@@ -328,7 +449,14 @@ fn trace_in(s: &Structures, job: &Job, method: Method) -> Rendered {
         .with_dacrt(s.dacrt);
     let t0 = Instant::now();
     let frame = render(s.scene, &tracer, &job.camera, job.light, &settings);
-    Rendered { frame, wall_s: t0.elapsed().as_secs_f64(), settings: job.settings, paths: None, animation: None }
+    Rendered {
+        frame,
+        wall_s: t0.elapsed().as_secs_f64(),
+        settings: job.settings,
+        paths: None,
+        animation: None,
+        hybrid: None,
+    }
 }
 
 /// Adds one distribution pass, traced in `s`, to `p` on the current rayon pool and returns the refined image.
@@ -361,5 +489,6 @@ fn distribution_pass(p: &mut Progressive, s: &Structures) -> Rendered {
         settings: job.settings,
         paths: Some(p.acc.paths),
         animation: None,
+        hybrid: None,
     }
 }

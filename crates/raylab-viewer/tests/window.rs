@@ -243,3 +243,56 @@ fn animation_moves_objects_and_updates_the_structure_each_method_needs() {
     let (_, stats) = run_viewer(dir.path(), "still", true, &["--method", "dacrt"]);
     assert!(stats["animation"].is_null());
 }
+
+/// The hybrid mode end to end, offscreen under the GPU driver (lavapipe in CI): the R-buffer the viewer
+/// shows (its traced frame) holds the CPU Whitted renderer's first reflections, within 35 dB over the
+/// reflective pixels, with synchronous and asynchronous readback; interlacing traces a share of the rows; the
+/// composite is drawn.
+#[test]
+fn hybrid_mode_reflections_match_the_cpu_renderer() {
+    use raylab_core::render::hybrid::{psnr, reference_reflections};
+    use raylab_core::trace::Tracer;
+    let dir = tempfile::tempdir().unwrap();
+    let args = SceneArgs::named("atrium");
+    let (scene, _) = raylab_bench::prepare::load_scene(&args.source()).unwrap();
+    let (camera, light) = args.camera_and_light(&scene).unwrap();
+    let tree = raylab_core::kdtree::KdTree::build(&scene, &KdParams::default()).unwrap();
+    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let settings = RenderSettings { width: W, height: H, tile: TILE, ..RenderSettings::default() };
+    let want = reference_reflections(&scene, &tracer, &camera, light, &settings);
+    let reflective = want.iter().filter(|c| c.is_some()).count();
+    assert!(reflective > 500, "{reflective} reflective pixels in the view");
+    for (name, extra) in [("hybrid-sync", &["--sync-readback"][..]), ("hybrid-async", &[][..])] {
+        let traced = dir.path().join(format!("{name}-rbuffer.png"));
+        let mut all =
+            vec!["--mode", "hybrid", "--gbuffer-percent", "100", "--traced-screenshot", traced.to_str().unwrap()];
+        all.extend_from_slice(extra);
+        let (shot, stats) = run_viewer(dir.path(), name, true, &all);
+        let h = &stats["hybrid"];
+        assert_eq!(h["gbuffer"], serde_json::json!([W, H]), "{name}: {h}");
+        let (rays, flagged) = (h["rays"].as_u64().unwrap(), h["reflective_pixels"].as_u64().unwrap());
+        assert_eq!(rays, flagged, "{name}: every reflective pixel traced without interlacing");
+        assert!(
+            (flagged as f64 - reflective as f64).abs() <= 0.05 * reflective as f64,
+            "{name}: {flagged} vs {reflective}"
+        );
+        for k in ["raster_ms", "readback_ms", "trace_ms", "upload_ms", "composite_ms"] {
+            assert!(h[k].as_f64().is_some_and(|v| v >= 0.0), "{name}: {k} in {h}");
+        }
+        let r = image::open(&traced).unwrap().to_rgba8();
+        assert_eq!(r.dimensions(), (W, H));
+        let to_lin = |v: u8| (v as f32 / 255.0).powf(2.2);
+        let pairs = r
+            .pixels()
+            .zip(&want)
+            .filter_map(|(p, w)| w.map(|w| (glam::Vec3::new(to_lin(p.0[0]), to_lin(p.0[1]), to_lin(p.0[2])), w)));
+        let db = psnr(pairs).unwrap();
+        assert!(db >= 35.0, "{name}: R-buffer {db:.1} dB from the CPU renderer's reflections");
+        assert!(shot.pixels().filter(|p| p.0[0] > 40).count() > (W * H / 8) as usize, "{name}: composite drawn");
+    }
+    // Interlacing: half the rows a frame.
+    let (_, stats) = run_viewer(dir.path(), "hybrid-interlaced", true, &["--mode", "hybrid", "--interlace", "2"]);
+    let h = &stats["hybrid"];
+    let (rays, flagged) = (h["rays"].as_u64().unwrap(), h["reflective_pixels"].as_u64().unwrap());
+    assert!(rays * 3 < flagged * 2 && rays * 3 > flagged, "interlaced: {rays} rays for {flagged} reflective pixels");
+}

@@ -17,8 +17,8 @@ use raylab_core::scene::PointLight;
 use crate::camera_path::{CameraPath, Player, Recorder};
 use crate::fly::{FlyCamera, MoveKeys};
 use crate::loader::{LoadPoll, LoadedScene, PendingLoad};
-use crate::settings::ViewerSettings;
-use crate::worker::{Job, Rendered, Worker, WorkerEvent};
+use crate::settings::{RenderMode, ViewerSettings};
+use crate::worker::{Job, ReflectionJob, Rendered, Worker, WorkerEvent};
 pub use bookmarks::Bookmarks;
 use compare_table::CompareTable;
 pub use readouts::{Readouts, StatsReport};
@@ -27,6 +27,8 @@ pub use readouts::{Readouts, StatsReport};
 const MESSAGE_TIME: Duration = Duration::from_secs(8);
 /// Redraw interval while only a progress indicator moves.
 const PROGRESS_REDRAW: Duration = Duration::from_millis(100);
+/// How often the UI polls for G-buffers coming back from the GPU (hybrid mode, asynchronous readback).
+const HYBRID_POLL: Duration = Duration::from_millis(2);
 
 /// A line shown at the bottom of the window.
 struct Message {
@@ -58,6 +60,12 @@ pub struct Lab {
     messages: Vec<Message>,
     latest: Option<Box<Rendered>>,
     fresh: bool,
+    /// Hybrid mode: a G-buffer's reflections are being traced.
+    hybrid_busy: bool,
+    /// Hybrid mode: G-buffers are on their way back from the GPU (the UI polls for them).
+    hybrid_pending: bool,
+    /// Hybrid mode: GPU-side milliseconds of the last R-buffer upload and composite.
+    pub hybrid_gpu_ms: Option<(f64, f64)>,
     /// Frame times and counters.
     pub readouts: Readouts,
     compare: CompareTable,
@@ -116,6 +124,9 @@ impl Lab {
             messages: Vec::new(),
             latest: None,
             fresh: false,
+            hybrid_busy: false,
+            hybrid_pending: false,
+            hybrid_gpu_ms: None,
             readouts: Readouts::default(),
             compare: CompareTable::default(),
             bookmarks,
@@ -134,6 +145,16 @@ impl Lab {
             path_file: "camera-path.json".into(),
             file_dialog: None,
         }
+    }
+
+    /// The scene on screen, shared.
+    pub fn scene_arc(&self) -> Arc<LoadedScene> {
+        Arc::clone(&self.scene)
+    }
+
+    /// The light.
+    pub fn light(&self) -> PointLight {
+        self.light
     }
 
     /// The scene on screen.
@@ -306,6 +327,9 @@ impl Lab {
         for ev in self.worker.drain() {
             match ev {
                 WorkerEvent::Frame(r) => {
+                    if r.hybrid.is_some() {
+                        self.hybrid_busy = false;
+                    }
                     self.readouts.push(&r);
                     self.latest = Some(r);
                     self.fresh = true;
@@ -344,6 +368,9 @@ impl Lab {
         if self.loading.is_some() || self.compare.running() {
             return Some(PROGRESS_REDRAW);
         }
+        if self.hybrid_pending && !self.hybrid_busy {
+            return Some(HYBRID_POLL);
+        }
         self.messages.iter().map(|m| MESSAGE_TIME.saturating_sub(m.at.elapsed())).min()
     }
 
@@ -379,10 +406,41 @@ impl Lab {
         }
     }
 
+    /// Hybrid mode: the view to rasterise next (at the G-buffer's size), when the view changed or frames are
+    /// traced continuously, and no reflections are being traced.
+    pub fn hybrid_request(&mut self) -> Option<Job> {
+        let (w, h) = self.window;
+        let wanted = self.dirty || self.settings.continuous;
+        if self.settings.mode != RenderMode::Hybrid || !wanted || w == 0 || h == 0 || self.compare.running() {
+            return None;
+        }
+        self.dirty = false;
+        let mut job = self.job();
+        job.size = job.settings.hybrid.gbuffer_size(job.size.0, job.size.1);
+        Some(job)
+    }
+
+    /// Hybrid mode: true when the worker can take a G-buffer.
+    pub fn hybrid_idle(&self) -> bool {
+        !self.hybrid_busy
+    }
+
+    /// Hybrid mode: hands a G-buffer read back from the GPU to the worker.
+    pub fn trace_reflections(&mut self, job: ReflectionJob) {
+        self.hybrid_busy = true;
+        self.worker.reflections(job);
+    }
+
+    /// Hybrid mode: whether G-buffers are on their way back (so the UI keeps polling).
+    pub fn set_hybrid_pending(&mut self, pending: bool) {
+        self.hybrid_pending = pending;
+    }
+
     /// Sends the current view to the worker when it changed.
     fn submit(&mut self) {
         let (w, h) = self.window;
-        if !self.dirty || w == 0 || h == 0 || self.compare.running() {
+        let hybrid = self.settings.mode == RenderMode::Hybrid;
+        if !self.dirty || w == 0 || h == 0 || self.compare.running() || hybrid {
             return;
         }
         self.dirty = false;
@@ -518,6 +576,7 @@ mod tests {
             shadows: Shadows::Hard,
             depth: 3,
             distribution: DistributionControls::default(),
+            hybrid: crate::settings::HybridControls::default(),
             order: RayOrder::Scanline,
             show: FrameView::Shaded,
             heat_max: None,

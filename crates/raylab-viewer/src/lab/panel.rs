@@ -13,7 +13,8 @@ use crate::cli::value_name;
 use raylab_core::render::RenderSettings;
 use raylab_core::shadow::{SampleBound, ShadowKind, Shadows};
 
-use crate::settings::{RenderMode, ViewerSettings};
+use crate::settings::{HybridControls, RenderMode, ViewerSettings};
+use crate::worker::HybridFrame;
 
 /// Draws the panel.
 pub fn show(lab: &mut Lab, ui: &mut egui::Ui) {
@@ -160,12 +161,18 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
     let light_radius = lab.light.radius;
     let paths = lab.latest().and_then(|r| r.paths);
     let animation = lab.latest().and_then(|r| r.animation);
+    let hybrid = lab.latest().and_then(|r| r.hybrid.clone());
+    let gpu_ms = lab.hybrid_gpu_ms;
     let s = &mut lab.settings;
     egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| {
         egui::ComboBox::from_label("mode").selected_text(value_name(&s.mode)).show_ui(ui, |ui| {
             ui.selectable_value(&mut s.mode, RenderMode::Whitted, "whitted");
             ui.selectable_value(&mut s.mode, RenderMode::Distribution, "distribution");
+            ui.selectable_value(&mut s.mode, RenderMode::Hybrid, "hybrid (G-buffer)");
         });
+        if s.mode == RenderMode::Hybrid {
+            hybrid_controls(ui, s, hybrid.as_deref(), gpu_ms);
+        }
         if s.mode == RenderMode::Distribution {
             let d = &mut s.distribution;
             ui.add(egui::Slider::new(&mut d.bounces, 1..=7).text("bounces"));
@@ -232,8 +239,12 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
         ui.add(egui::Slider::new(&mut s.threads, 1..=(2 * cpus).max(2)).text("threads"));
         ui.add(egui::Slider::new(&mut s.scale, 25..=100).text("render scale %"));
         ui.checkbox(&mut s.continuous, "trace continuously").on_hover_text("keep tracing a still view for steady FPS");
-        ui.checkbox(&mut s.animate, "animate (spinning mirror, bouncing ball)")
-            .on_hover_text("move objects every frame: the kd-tree is rebuilt, the MBVH refitted, DACRT needs nothing");
+        ui.add_enabled(
+            s.mode != RenderMode::Hybrid,
+            egui::Checkbox::new(&mut s.animate, "animate (spinning mirror, bouncing ball)"),
+        )
+        .on_hover_text("move objects every frame: the kd-tree is rebuilt, the MBVH refitted, DACRT needs nothing")
+        .on_disabled_hover_text("the hybrid mode rasterises the loaded scene, which does not move yet");
         if let Some(u) = animation.filter(|_| s.animate) {
             animation_readout(ui, &u);
         }
@@ -352,4 +363,38 @@ fn animation_readout(ui: &mut egui::Ui, u: &UpdateTimes) {
     .flatten()
     .collect();
     ui.small(format!("t = {:.1} s, {} moving triangles: {}", u.time_s, u.moving_triangles, parts.join(", ")));
+}
+
+/// The hybrid mode's G-buffer resolution, interlacing, readback and reflection method, and what its last
+/// frame cost.
+fn hybrid_controls(ui: &mut egui::Ui, s: &mut ViewerSettings, last: Option<&HybridFrame>, gpu_ms: Option<(f64, f64)>) {
+    let h = &mut s.hybrid;
+    egui::ComboBox::from_label("G-buffer").selected_text(format!("{}%", h.gbuffer_percent)).show_ui(ui, |ui| {
+        for p in HybridControls::PERCENTS {
+            ui.selectable_value(&mut h.gbuffer_percent, p, format!("{p}%"));
+        }
+    });
+    egui::ComboBox::from_label("interlacing").selected_text(format!("1/{}", h.interlace)).show_ui(ui, |ui| {
+        for k in HybridControls::INTERLACE {
+            ui.selectable_value(&mut h.interlace, k, format!("1/{k} of the rows a frame"));
+        }
+    });
+    ui.checkbox(&mut h.async_readback, "asynchronous readback")
+        .on_hover_text("read the G-buffer a frame late through double-buffered staging buffers instead of waiting");
+    egui::ComboBox::from_label("reflection method").selected_text(h.method.name()).show_ui(ui, |ui| {
+        for m in Method::ALL.into_iter().filter(|&m| m != Method::Reference) {
+            ui.selectable_value(&mut h.method, m, m.name());
+        }
+    });
+    if let Some(f) = last {
+        ui.small(format!(
+            "{}x{} G-buffer: {} reflective pixels, {} rays traced",
+            f.size.0, f.size.1, f.reflective, f.rays
+        ));
+        let (upload, composite) = gpu_ms.unwrap_or((0.0, 0.0));
+        ui.small(format!(
+            "ms: raster {:.1}, readback {:.1}, trace {:.1}, upload {:.1}, composite {:.1}",
+            f.raster_ms, f.readback_ms, f.trace_ms, upload, composite
+        ));
+    }
 }

@@ -1,0 +1,196 @@
+//! The hybrid render mode (seed 003, Stokes 2014): the GPU rasterises a G-buffer ([`gbuffer`]), it is read
+//! back through double-buffered staging buffers ([`readback`]), and the CPU traces only the reflection rays of
+//! reflective pixels (`raylab_core::render::hybrid`).
+
+pub mod composite;
+pub mod gbuffer;
+pub mod readback;
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::time::Instant;
+
+use composite::CompositePass;
+use gbuffer::GBufferPass;
+use readback::Readback;
+
+use crate::compositor::Compositor;
+use crate::gpu::Gpu;
+use crate::lab::Lab;
+use crate::loader::LoadedScene;
+use crate::worker::{HybridFrame, Job, ReflectionJob};
+
+/// A rasterised G-buffer on its way back to the CPU.
+struct InFlight {
+    slot: usize,
+    job: Job,
+    raster_ms: f64,
+}
+
+/// The GPU side of the hybrid mode: raster pass, readback and composite, and the scene they were given.
+pub struct HybridGpu {
+    gbuffer: GBufferPass,
+    readback: Readback,
+    composite: CompositePass,
+    scene: Option<Arc<LoadedScene>>,
+    in_flight: VecDeque<InFlight>,
+}
+
+impl HybridGpu {
+    /// The passes, with no scene yet.
+    pub fn new(device: &wgpu::Device) -> Self {
+        Self {
+            gbuffer: GBufferPass::new(device),
+            readback: Readback::default(),
+            composite: CompositePass::new(device),
+            scene: None,
+            in_flight: VecDeque::new(),
+        }
+    }
+
+    /// One UI frame's work: rasterise the view `lab` asks for (at most two G-buffers in flight), and hand the
+    /// oldest G-buffer back from the GPU to the worker once it is idle (waiting for it with synchronous
+    /// readback).
+    pub fn step(&mut self, gpu: &Gpu, lab: &mut Lab) {
+        let scene = &lab.scene_arc();
+        if self.scene.as_ref().is_none_or(|s| !Arc::ptr_eq(s, scene)) {
+            self.gbuffer.set_scene(&gpu.device, &gpu.queue, &scene.scene);
+            self.composite.set_scene(&gpu.queue, &scene.scene);
+            self.scene = Some(Arc::clone(scene));
+            self.in_flight.clear();
+        }
+        if self.in_flight.len() < 2
+            && let Some(job) = lab.hybrid_request()
+        {
+            let t0 = Instant::now();
+            let mut encoder =
+                gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });
+            let near = 1e-4 * job.scene.scene.bounds().diagonal().max(f32::MIN_POSITIVE);
+            self.gbuffer.record(&gpu.device, &gpu.queue, &mut encoder, &job.camera, job.size, near);
+            let slot = self.gbuffer.targets().map(|t| self.readback.record(&gpu.device, &mut encoder, t));
+            gpu.queue.submit([encoder.finish()]);
+            if let Some(slot) = slot {
+                self.readback.map(slot);
+                let raster_ms = t0.elapsed().as_secs_f64() * 1e3;
+                self.in_flight.push_back(InFlight { slot, job, raster_ms });
+            }
+        }
+        if lab.hybrid_idle()
+            && let Some(f) = self.in_flight.front()
+        {
+            let wait = !f.job.settings.hybrid.async_readback;
+            let t0 = Instant::now();
+            match self.readback.take(&gpu.device, f.slot, wait) {
+                Ok(Some(gbuffer)) => {
+                    if let Some(f) = self.in_flight.pop_front() {
+                        let readback_ms = t0.elapsed().as_secs_f64() * 1e3;
+                        lab.trace_reflections(ReflectionJob {
+                            job: f.job,
+                            gbuffer,
+                            raster_ms: f.raster_ms,
+                            readback_ms,
+                        });
+                    }
+                }
+                Ok(None) => {}
+                Err(e) => {
+                    self.in_flight.pop_front();
+                    lab.message(e, true);
+                }
+            }
+        }
+        lab.set_hybrid_pending(!self.in_flight.is_empty());
+    }
+
+    /// Uploads `frame`'s R-buffer and composites it with the latest G-buffer into the compositor's frame
+    /// texture; returns the CPU milliseconds of the upload and of the composite, or `None` when the G-buffer
+    /// was resized since (the next frame catches up).
+    pub fn show(
+        &mut self,
+        gpu: &Gpu,
+        compositor: &mut Compositor,
+        frame: &HybridFrame,
+        lab: &Lab,
+    ) -> Option<(f64, f64)> {
+        let t0 = Instant::now();
+        self.composite.upload(&gpu.device, &gpu.queue, frame.size, &frame.rbuffer);
+        let upload_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let t1 = Instant::now();
+        let targets = self.gbuffer.targets().filter(|t| t.size == frame.size)?;
+        let out = compositor.frame_target(&gpu.device, frame.size);
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("composite") });
+        let light = lab.light();
+        let drawn = self.composite.record(gpu, &mut encoder, targets, &light, frame.eye, &out);
+        gpu.queue.submit([encoder.finish()]);
+        drawn.then(|| (upload_ms, t1.elapsed().as_secs_f64() * 1e3))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use raylab_core::kdtree::{KdParams, KdTree};
+    use raylab_core::render::RenderSettings;
+    use raylab_core::render::hybrid::{psnr, reference_reflections, reflection_ray, shade_reflections};
+    use raylab_core::render::surface_epsilon;
+    use raylab_core::trace::{TraceOptions, Tracer};
+    use raylab_scene::builtin::{self, Detail};
+
+    use super::gbuffer::GBufferPass;
+    use super::readback::Readback;
+    use crate::gpu::Gpu;
+
+    /// The GPU's G-buffer (under lavapipe in CI) gives reflections within 35 dB of the CPU Whitted renderer's
+    /// first reflections over the pixels both see as reflective, and flags nearly the same pixels.
+    #[test]
+    fn hybrid_reflections_match_the_cpu_renderer() {
+        let gpu = Gpu::new(&Gpu::instance(None), None).expect("a GPU adapter (lavapipe in CI)");
+        let scene = builtin::build("atrium", Detail::Test).unwrap();
+        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let tracer = Tracer::new(&tree, None, TraceOptions::default());
+        let cam = scene.default_view().unwrap().camera;
+        let light = scene.lights[0];
+        let (w, h) = (160u32, 120u32);
+        let mut pass = GBufferPass::new(&gpu.device);
+        pass.set_scene(&gpu.device, &gpu.queue, &scene);
+        let mut readback = Readback::default();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let near = 1e-4 * scene.bounds().diagonal();
+        pass.record(&gpu.device, &gpu.queue, &mut encoder, &cam, (w, h), near);
+        let slot = readback.record(&gpu.device, &mut encoder, pass.targets().unwrap());
+        gpu.queue.submit([encoder.finish()]);
+        readback.map(slot);
+        let g = readback.take(&gpu.device, slot, true).unwrap().expect("a mapped G-buffer");
+        assert_eq!((g.width, g.height, g.pixels.len()), (w, h, (w * h) as usize));
+
+        let settings = RenderSettings { width: w, height: h, ..RenderSettings::default() };
+        let want = reference_reflections(&scene, &tracer, &cam, light, &settings);
+        let eps = surface_epsilon(&scene);
+        let rays: Vec<_> = g.pixels.iter().map(|p| reflection_ray(cam.eye, p, eps)).collect();
+        let (got, _, _) = shade_reflections(&scene, &tracer, &cam, light, &settings, &rays);
+        let (cpu, gpu_flags) =
+            (want.iter().filter(|c| c.is_some()).count(), rays.iter().filter(|r| r.is_some()).count());
+        let both: Vec<_> =
+            rays.iter().zip(&got).zip(&want).filter_map(|((r, g), w)| r.and(*w).map(|w| (*g, w))).collect();
+        assert!(cpu > 200, "{cpu} reflective pixels");
+        // Rasterisation and ray casting may disagree on a mirror's silhouette pixels only.
+        assert!(
+            both.len() * 100 >= cpu.max(gpu_flags) * 95,
+            "{} of {cpu} CPU / {gpu_flags} GPU pixels agree",
+            both.len()
+        );
+        let db = psnr(both).unwrap();
+        assert!(db >= 35.0, "hybrid reflections {db:.1} dB from the CPU renderer's");
+        // The G-buffer's positions are the CPU's hit points, to rounding.
+        let cpu_g = raylab_core::render::hybrid::cpu_gbuffer(&scene, &tracer, &cam, w, h);
+        let close = g
+            .pixels
+            .iter()
+            .zip(&cpu_g)
+            .filter(|(a, b)| a.material.is_some() && b.material.is_some())
+            .filter(|(a, b)| (a.position - b.position).length() <= 1e-3 * scene.bounds().diagonal())
+            .count();
+        let covered = cpu_g.iter().filter(|p| p.material.is_some()).count();
+        assert!(close * 100 >= covered * 97, "{close} of {covered} positions match");
+    }
+}
