@@ -64,6 +64,9 @@ impl Frontend {
             Some((Some(h), _, _)) => {
                 let shown = self.hybrid.as_mut().and_then(|g| g.show(&self.gpu, &mut self.compositor, &h, lab));
                 lab.hybrid_gpu_ms = shown;
+                if let Some((upload, composite)) = shown {
+                    lab.readouts.push_hybrid_gpu(upload, composite);
+                }
                 shown.map(|(upload, composite)| upload + composite)
             }
             Some((None, w, h)) => {
@@ -156,9 +159,10 @@ struct StatsFile<'a> {
     readouts: StatsReport,
 }
 
-/// The hybrid mode's part of the `--json-stats` file.
+/// The hybrid mode's part of the `--json-stats` file: the last frame, and medians over all frames.
 #[derive(Serialize)]
 struct HybridStats {
+    medians: Option<crate::lab::HybridReport>,
     gbuffer: [u32; 2],
     reflective_pixels: usize,
     rays: usize,
@@ -197,6 +201,7 @@ impl Automation {
                 paths: latest.paths,
                 animation: latest.animation,
                 hybrid: latest.hybrid.as_ref().map(|h| HybridStats {
+                    medians: lab.readouts.hybrid_report(),
                     gbuffer: [h.size.0, h.size.1],
                     reflective_pixels: h.reflective,
                     rays: h.rays,

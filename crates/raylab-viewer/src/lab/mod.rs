@@ -21,7 +21,7 @@ use crate::settings::{RenderMode, ViewerSettings};
 use crate::worker::{Job, ReflectionJob, Rendered, Worker, WorkerEvent};
 pub use bookmarks::Bookmarks;
 use compare_table::CompareTable;
-pub use readouts::{Readouts, StatsReport};
+pub use readouts::{HybridReport, Readouts, StatsReport};
 
 /// How long a message stays on screen.
 const MESSAGE_TIME: Duration = Duration::from_secs(8);

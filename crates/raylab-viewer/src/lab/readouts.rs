@@ -36,6 +36,21 @@ pub struct Readouts {
     upload_ms: Vec<f64>,
     ui_ms: Vec<f64>,
     ui_frames: VecDeque<Instant>,
+    /// Hybrid mode, per frame: raster, readback and trace ms, and when the frame arrived.
+    hybrid_cpu: Vec<([f64; 3], Instant)>,
+    /// Hybrid mode, per frame shown: upload and composite ms.
+    hybrid_gpu: Vec<[f64; 2]>,
+}
+
+/// The hybrid mode's medians over the frames so far (`--json-stats`).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct HybridReport {
+    /// Median ms of raster, readback, trace, upload and composite.
+    pub stage_ms_median: [f64; 5],
+    /// Median of raster + readback + trace: the CPU part of a frame.
+    pub cpu_ms_median: f64,
+    /// Median time between two R-buffers arriving (the hybrid frame period), in ms.
+    pub period_ms_median: f64,
 }
 
 impl Default for Readouts {
@@ -50,6 +65,8 @@ impl Default for Readouts {
             upload_ms: Vec::new(),
             ui_ms: Vec::new(),
             ui_frames: VecDeque::new(),
+            hybrid_cpu: Vec::new(),
+            hybrid_gpu: Vec::new(),
         }
     }
 }
@@ -79,6 +96,34 @@ impl Readouts {
         self.totals += s;
         self.stages += r.frame.stages;
         self.last = Some((s, r.frame.stages, r.wall_s));
+        if let Some(h) = &r.hybrid {
+            self.hybrid_cpu.push(([h.raster_ms, h.readback_ms, h.trace_ms], Instant::now()));
+        }
+    }
+
+    /// Records the GPU-side cost of showing a hybrid frame: R-buffer upload and composite, in ms.
+    pub fn push_hybrid_gpu(&mut self, upload_ms: f64, composite_ms: f64) {
+        self.hybrid_gpu.push([upload_ms, composite_ms]);
+    }
+
+    /// The hybrid mode's medians, when hybrid frames were made.
+    pub fn hybrid_report(&self) -> Option<HybridReport> {
+        if self.hybrid_cpu.is_empty() {
+            return None;
+        }
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(0.0)
+        };
+        let cpu = |k: usize| median(self.hybrid_cpu.iter().map(|h| h.0[k]).collect());
+        let gpu = |k: usize| median(self.hybrid_gpu.iter().map(|h| h[k]).collect());
+        let periods: Vec<f64> =
+            self.hybrid_cpu.windows(2).map(|w| w[1].1.duration_since(w[0].1).as_secs_f64() * 1e3).collect();
+        Some(HybridReport {
+            stage_ms_median: [cpu(0), cpu(1), cpu(2), gpu(0), gpu(1)],
+            cpu_ms_median: median(self.hybrid_cpu.iter().map(|h| h.0.iter().sum()).collect()),
+            period_ms_median: median(periods),
+        })
     }
 
     /// Records the GPU-side cost of a UI frame: uploading a traced frame (when one was) and building and

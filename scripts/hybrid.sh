@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Regenerates the hybrid-mode section of docs/BENCHMARKS.md (seed 003, Stokes 2014, Figures 8-10): the viewer
+# offscreen in hybrid mode (GPU G-buffer, CPU reflections, GPU composite) at 1280x720, median milliseconds per
+# stage over FRAMES frames, (a) against the G-buffer resolution, (b) against the triangle count (the built-in
+# scenes and the shared Sponza), (c) with synchronous and asynchronous readback and with interlacing. Run it on
+# a committed tree; it needs a Vulkan driver (apt-get install mesa-vulkan-drivers libvulkan1).
+#
+#   scripts/hybrid.sh                 # 40 frames per row
+#   FRAMES=20 scripts/hybrid.sh
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=lib/splice.sh
+source "$root/scripts/lib/splice.sh"
+frames=${FRAMES:-40}
+cargo build --release -p raylab-viewer --manifest-path "$root/Cargo.toml"
+cd "$root"
+export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(mktemp -d)}
+work=$(mktemp -d)
+table="$work/table.md"
+commit=$(git describe --always --dirty --abbrev=12)
+cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
+sponza=(--scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0)
+{
+  echo "Machine and build: commit $commit, $(rustc --version), CPU $cpu ($(nproc) logical CPUs), the GPU named in each run's stats (lavapipe here: Mesa's software Vulkan, on the same CPU)."
+  echo "Command: \`scripts/hybrid.sh\` (FRAMES=$frames): for each row, \`target/release/raylab --headless --mode hybrid --width 1280 --height 720 --no-panel --frames $frames --json-stats FILE\` with the row's flags; medians over the frames. CPU part = raster (record and submit) + readback + trace."
+  echo
+  echo "| part | scene | triangles | G-buffer | readback | interlace | reflection method | reflective px | rays | raster ms | readback ms | trace ms | upload ms | composite ms | CPU part ms | frame period ms |"
+  echo "|---|---|---:|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+} > "$table"
+row() {
+  local part=$1; shift
+  local stats="$work/run.json"
+  target/release/raylab --headless --mode hybrid --width 1280 --height 720 --no-panel --frames "$frames" \
+    --json-stats "$stats" "$@" > /dev/null
+  python3 - "$stats" "$part" >> "$table" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+h, s = d["hybrid"], d["settings"]["hybrid"]
+m = h["medians"]["stage_ms_median"]
+med = h["medians"]
+print(f"| {sys.argv[2]} | {d['scene']} | {d['triangles']} | {s['gbuffer_percent']}% ({h['gbuffer'][0]}x{h['gbuffer'][1]}) "
+      f"| {'async' if s['async_readback'] else 'sync'} | {s['interlace']} | {s['method']} | {h['reflective_pixels']} | {h['rays']} "
+      f"| {m[0]:.2f} | {m[1]:.2f} | {m[2]:.2f} | {m[3]:.2f} | {m[4]:.2f} | {med['cpu_ms_median']:.2f} | {med['period_ms_median']:.2f} |")
+PY
+}
+for pct in 25 50 100; do row "(a) resolution" --scene atrium --gbuffer-percent "$pct"; done
+for scene in arena kitchen atrium forest; do row "(b) triangles" --scene "$scene"; done
+row "(b) triangles" "${sponza[@]}"
+row "(c) readback" --scene atrium --sync-readback
+row "(c) readback" --scene atrium
+for k in 2 4; do row "(c) interlacing" --scene atrium --interlace "$k"; done
+for m in mono mbvh; do row "(c) method" --scene atrium --hybrid-method "$m"; done
+
+splice_section hybrid "$table"
+rm -rf "$work"
+echo "updated docs/BENCHMARKS.md"
