@@ -413,7 +413,9 @@ fn reflections(r: &ReflectionJob, kept: &mut Interlaced) -> Rendered {
             kept.colors[i] = [c.x, c.y, c.z, 1.0];
         }
     }
-    let rgba = kept.colors.iter().map(|c| [to_display(c[0]), to_display(c[1]), to_display(c[2]), 255]).collect();
+    // Most pixels reflect nothing: skip the gamma curve for black.
+    let show = |v: f32| if v > 0.0 { to_display(v) } else { 0 };
+    let rgba = kept.colors.iter().map(|c| [show(c[0]), show(c[1]), show(c[2]), 255]).collect();
     let trace_ms = t0.elapsed().as_secs_f64() * 1e3;
     let frame = Frame { width: w, height: h, rgba, stats, stages, range: None };
     let hybrid = HybridFrame {

@@ -7,6 +7,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::method::Method;
 use crate::ray::{Hit, Ray};
 use crate::scene::{Camera, PointLight, Scene};
 use crate::stats::TraversalStats;
@@ -46,10 +47,14 @@ pub fn reflection_seed(index: u32) -> u32 {
     index.wrapping_mul(0x2C1B_3C6D).wrapping_add(1)
 }
 
-/// Linear colours of a `width x height` layer of reflection rays (one per pixel, `None` where none is traced),
-/// traced with `tracer` and shaded one bounce deep under `settings.shadows`; black where there is no ray or no
-/// hit. Rows are traced in bands taken by the threads of the current rayon pool (bands as large as the method
-/// wants its sets). Returns the colours, the work and the time per stage.
+/// Rays per set below which the non-DACRT methods stop splitting a frame's reflection rays among threads.
+const MIN_CHUNK: usize = 256;
+
+/// Linear colours of a `width x height` layer of reflection rays (one slot per pixel, `None` where none is
+/// traced), traced with `tracer` and shaded one bounce deep under `settings.shadows`; black where there is no
+/// ray or no hit. Only the rays present are traced: gathered in pixel order into sets shared among the
+/// threads of the current rayon pool (for DACRT, sets of at least [`Method::DACRT_MIN_SET`] rays, since each
+/// set divides the whole scene again). Returns the colours, the work and the time per stage.
 pub fn shade_reflections(
     scene: &Scene,
     tracer: &Tracer,
@@ -60,8 +65,10 @@ pub fn shade_reflections(
 ) -> (Vec<Vec3>, TraversalStats, StageTimes) {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     assert_eq!(rays.len(), (w * h) as usize, "one ray slot per pixel");
-    let edge = tracer.options.method.tile_edge(settings.tile, 1);
-    let band = (edge * edge).div_ceil(w).clamp(1, h);
+    let present: Vec<usize> = rays.iter().enumerate().filter(|(_, r)| r.is_some()).map(|(i, _)| i).collect();
+    let threads = rayon::current_num_threads().max(1);
+    let min_set = if tracer.options.method.uses_dacrt() { Method::DACRT_MIN_SET as usize } else { MIN_CHUNK };
+    let chunk = present.len().div_ceil(threads).max(min_set).max(1);
     let one_bounce = RenderSettings { max_depth: 1, ..*settings };
     let ctx = TileContext {
         scene,
@@ -72,30 +79,30 @@ pub fn shade_reflections(
         width: w,
         epsilon: surface_epsilon(scene),
         order: super::RayOrder::Scanline,
-        tile: edge,
+        tile: settings.tile,
         offsets: Vec::new(),
     };
-    let bands: Vec<(Vec<Vec3>, TileOut)> = rays
-        .par_chunks((band * w) as usize)
-        .enumerate()
-        .map(|(b, chunk)| {
-            let first = b as u32 * band * w;
-            let seeds: Vec<u32> = (0..chunk.len() as u32).map(|i| reflection_seed(first + i)).collect();
+    let sets: Vec<(Vec<Vec3>, TileOut)> = present
+        .par_chunks(chunk)
+        .map(|ids| {
+            let set: Vec<Option<Ray>> = ids.iter().map(|&i| rays[i]).collect();
+            let seeds: Vec<u32> = ids.iter().map(|&i| reflection_seed(i as u32)).collect();
             let mut out = TileOut::default();
             let t0 = std::time::Instant::now();
-            let mut hits = vec![None; chunk.len()];
-            let rows = chunk.len() / w as usize;
-            tracer.intersect_tile(chunk, w as usize, rows, &mut hits, &mut out.stats);
+            let mut hits = vec![None; set.len()];
+            tracer.intersect_tile(&set, set.len(), 1, &mut hits, &mut out.stats);
             out.stages.secondary += t0.elapsed().as_secs_f64();
-            let layer = Layer { rays: chunk, hits: &hits, dims: (w as usize, rows), seeds: &seeds };
+            let layer = Layer { rays: &set, hits: &hits, dims: (set.len(), 1), seeds: &seeds };
             let colors = ctx.shade_layer(layer, 1, &mut out, &mut ShadowScratch::default());
             (colors, out)
         })
         .collect();
-    let mut colors = Vec::with_capacity(rays.len());
+    let mut colors = vec![Vec3::ZERO; rays.len()];
     let (mut stats, mut stages) = (TraversalStats::default(), StageTimes::default());
-    for (c, out) in bands {
-        colors.extend(c);
+    for (ids, (c, out)) in present.chunks(chunk).zip(sets) {
+        for (&i, c) in ids.iter().zip(c) {
+            colors[i] = c;
+        }
         stats += out.stats;
         stages += out.stages;
     }
