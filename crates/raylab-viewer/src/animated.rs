@@ -65,11 +65,16 @@ impl AnimatedScene {
 
     /// Moves the objects to the current time and updates what a frame with `settings` traces.
     pub fn step(&mut self, settings: &ViewerSettings) -> Result<UpdateTimes, String> {
-        let time_s = self.start.elapsed().as_secs_f64();
+        self.step_at(self.start.elapsed().as_secs_f64(), settings)
+    }
+
+    /// Moves the objects to time `time_s` (the hybrid mode's G-buffer gives it) and updates what a frame
+    /// with `settings` traces.
+    pub fn step_at(&mut self, time_s: f64, settings: &ViewerSettings) -> Result<UpdateTimes, String> {
         self.anim.apply(&mut self.scene, time_s as f32)?;
         let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
         let mut out = UpdateTimes { time_s, moving_triangles: self.anim.moving_triangles(), ..UpdateTimes::default() };
-        let method = settings.trace.method;
+        let method = settings.frame_method();
         if needs_kd_tree(settings) {
             let t = Instant::now();
             self.tree =
@@ -91,11 +96,12 @@ impl AnimatedScene {
 }
 
 /// True when a frame with `settings` walks the kd-tree: the kd-tree methods, edge-width shadows (always traced
-/// through it) and multi-sampled shadows (bounded by packets, pyramids or cones over it).
+/// through it) and multi-sampled shadows (bounded by packets, pyramids or cones over it), in the Whitted and
+/// hybrid modes.
 fn needs_kd_tree(settings: &ViewerSettings) -> bool {
-    let m = settings.trace.method;
+    let m = settings.frame_method();
     let structure_free = matches!(m, Method::Mbvh | Method::MbvhRs | Method::Dacrt);
-    let shadows_on_kd = settings.mode == RenderMode::Whitted
+    let shadows_on_kd = settings.mode != RenderMode::Distribution
         && matches!(settings.shadows, Shadows::EdgeWidth { .. } | Shadows::MultiSample { .. });
     !structure_free || shadows_on_kd
 }

@@ -116,9 +116,6 @@ impl Cli {
         if self.hybrid_method == raylab_core::method::Method::Reference {
             return Err("--hybrid-method reference: brute force is for tests, far too slow to fly with".into());
         }
-        if self.animate && self.mode == RenderMode::Hybrid {
-            return Err("--animate: the hybrid mode rasterises the loaded scene, which does not move yet".into());
-        }
         Ok(())
     }
 

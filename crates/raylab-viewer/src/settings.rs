@@ -152,6 +152,11 @@ impl ViewerSettings {
         }
     }
 
+    /// The method that traces this mode's rays: the reflection method in hybrid mode, else the method.
+    pub fn frame_method(&self) -> Method {
+        if self.mode == RenderMode::Hybrid { self.hybrid.method } else { self.trace.method }
+    }
+
     /// Why `method` cannot be chosen in the current mode, if it cannot.
     pub fn method_unavailable(&self, method: Method) -> Option<&'static str> {
         match method {

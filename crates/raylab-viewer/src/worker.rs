@@ -72,6 +72,9 @@ pub struct ReflectionJob {
     /// CPU milliseconds spent reading the G-buffer back: waiting for the GPU (synchronous readback) and
     /// unpacking the staging buffers.
     pub readback_ms: f64,
+    /// With the animation on, the animation time the G-buffer shows (the reflections are traced in the
+    /// scene posed at the same time).
+    pub animation_time: Option<f64>,
 }
 
 /// What the hybrid mode's CPU part made of a G-buffer.
@@ -319,6 +322,8 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
                     }
                 }
             }
+            // The reflections of an animated G-buffer pose the scene themselves, at the G-buffer's time.
+            Task::Reflections(r) if r.animation_time.is_some() => None,
             _ => {
                 animated = None;
                 None
@@ -350,7 +355,32 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
                 send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
             }
             Task::Reflections(r) => {
-                let rendered = pool.install(|| reflections(&r, &mut rbuffer));
+                let mut update = None;
+                if let Some(t) = r.animation_time {
+                    if !animated.as_ref().is_some_and(|a| a.animates(&r.job.scene)) {
+                        match pool.install(|| AnimatedScene::new(&r.job.scene)) {
+                            Ok(a) => animated = Some(a),
+                            Err(e) => {
+                                send(tx, wake, WorkerEvent::Error(e));
+                                continue;
+                            }
+                        }
+                    }
+                    let Some(a) = animated.as_mut() else { continue };
+                    match pool.install(|| a.step_at(t, &r.job.settings)) {
+                        Ok(u) => update = Some(u),
+                        Err(e) => {
+                            send(tx, wake, WorkerEvent::Error(e));
+                            continue;
+                        }
+                    }
+                }
+                let s = match (&animated, update) {
+                    (Some(a), Some(_)) => a.structures(),
+                    _ => r.job.scene.structures(),
+                };
+                let mut rendered = pool.install(|| reflections(&r, &s, &mut rbuffer));
+                rendered.animation = update;
                 send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
             }
             Task::Compare(job) => {
@@ -384,11 +414,10 @@ struct Interlaced {
 
 /// Traces and shades the reflection rays of `r`'s G-buffer on the current rayon pool: every row, or every
 /// k-th row in turn when interlacing (the other rows keep the previous frame's reflections).
-fn reflections(r: &ReflectionJob, kept: &mut Interlaced) -> Rendered {
+fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rendered {
     let t0 = Instant::now();
     let job = &r.job;
     let g = &r.gbuffer;
-    let s = job.scene.structures();
     let (w, h) = (g.width, g.height);
     let k = job.settings.hybrid.interlace.max(1);
     if kept.size != (w, h) || kept.colors.len() != g.pixels.len() {

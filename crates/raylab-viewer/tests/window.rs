@@ -246,8 +246,8 @@ fn animation_moves_objects_and_updates_the_structure_each_method_needs() {
 
 /// The hybrid mode end to end, offscreen under the GPU driver (lavapipe in CI): the R-buffer the viewer
 /// shows (its traced frame) holds the CPU Whitted renderer's first reflections, within 35 dB over the
-/// reflective pixels, with synchronous and asynchronous readback; interlacing traces a share of the rows; the
-/// composite is drawn.
+/// reflective pixels, with synchronous and asynchronous readback and with the animation on (the scene posed at
+/// the frame's time); interlacing traces a share of the rows; the composite is drawn.
 #[test]
 fn hybrid_mode_reflections_match_the_cpu_renderer() {
     use raylab_core::render::hybrid::{psnr, reference_reflections};
@@ -290,6 +290,30 @@ fn hybrid_mode_reflections_match_the_cpu_renderer() {
         assert!(db >= 35.0, "{name}: R-buffer {db:.1} dB from the CPU renderer's reflections");
         assert!(shot.pixels().filter(|p| p.0[0] > 40).count() > (W * H / 8) as usize, "{name}: composite drawn");
     }
+    // With the animation on, the G-buffer and the reflections show the scene posed at the same time.
+    let traced = dir.path().join("hybrid-animated-rbuffer.png");
+    let (_, stats) = run_viewer(
+        dir.path(),
+        "hybrid-animated",
+        true,
+        &["--mode", "hybrid", "--animate", "--gbuffer-percent", "100", "--traced-screenshot", traced.to_str().unwrap()],
+    );
+    let t = stats["animation"]["time_s"].as_f64().expect("animation times in the stats");
+    assert!(stats["animation"]["dacrt_setup_ms"].is_number(), "{}", stats["animation"]);
+    let (mut moved, anim) = raylab_scene::animation::Animation::add_movers(&scene);
+    anim.apply(&mut moved, t as f32).unwrap();
+    let tree = raylab_core::kdtree::KdTree::build(&moved, &KdParams::default()).unwrap();
+    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let want = reference_reflections(&moved, &tracer, &camera, light, &settings);
+    let r = image::open(&traced).unwrap().to_rgba8();
+    let to_lin = |v: u8| (v as f32 / 255.0).powf(2.2);
+    let pairs = r
+        .pixels()
+        .zip(&want)
+        .filter_map(|(p, w)| w.map(|w| (glam::Vec3::new(to_lin(p.0[0]), to_lin(p.0[1]), to_lin(p.0[2])), w)));
+    let db = psnr(pairs).unwrap();
+    assert!(db >= 35.0, "animated: R-buffer {db:.1} dB from the CPU renderer's reflections at t = {t}");
+
     // Interlacing: half the rows a frame.
     let (_, stats) = run_viewer(dir.path(), "hybrid-interlaced", true, &["--mode", "hybrid", "--interlace", "2"]);
     let h = &stats["hybrid"];

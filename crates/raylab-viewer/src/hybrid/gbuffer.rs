@@ -107,7 +107,7 @@ impl GBufferPass {
 
     /// Uploads `scene`'s triangles (replacing any earlier scene).
     pub fn set_scene(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, scene: &Scene) {
-        let data = vertex_data(scene);
+        let data = vertex_data(scene, 0);
         self.vertex_count = (data.len() / VERTEX_FLOATS) as u32;
         if data.is_empty() {
             self.vertices = None;
@@ -122,6 +122,18 @@ impl GBufferPass {
         });
         queue.write_buffer(&buffer, 0, &bytes);
         self.vertices = Some(buffer);
+    }
+
+    /// Re-uploads the triangles of `scene` from index `first` on (moved vertices; the same triangles as the
+    /// scene given to [`GBufferPass::set_scene`]).
+    pub fn update_triangles(&self, queue: &wgpu::Queue, scene: &Scene, first: usize) {
+        let Some(buffer) = &self.vertices else { return };
+        let data = vertex_data(scene, first);
+        if data.len() / VERTEX_FLOATS + first * 3 > self.vertex_count as usize {
+            return;
+        }
+        let bytes: Vec<u8> = data.iter().flat_map(|f| f.to_le_bytes()).collect();
+        queue.write_buffer(buffer, (first * 3 * VERTEX_FLOATS * 4) as u64, &bytes);
     }
 
     /// The targets of the last pass.
@@ -206,12 +218,13 @@ fn make_targets(device: &wgpu::Device, (w, h): (u32, u32)) -> Targets {
     }
 }
 
-/// Unindexed vertices of every triangle: position, shading normal (the vertex normal, or the face normal when
-/// the scene has none), face normal, material id and reflection weight.
-fn vertex_data(scene: &Scene) -> Vec<f32> {
-    let mut out = Vec::with_capacity(scene.triangle_count() * 3 * VERTEX_FLOATS);
+/// Unindexed vertices of the triangles from index `first` on: position, shading normal (the vertex normal,
+/// or the face normal when the scene has none), face normal, material id and reflection weight.
+fn vertex_data(scene: &Scene, first: usize) -> Vec<f32> {
+    let n = scene.triangle_count().saturating_sub(first);
+    let mut out = Vec::with_capacity(n * 3 * VERTEX_FLOATS);
     let has_normals = !scene.normals.is_empty() && scene.normals.len() == scene.positions.len();
-    for (i, t) in scene.triangles.iter().enumerate() {
+    for (i, t) in scene.triangles.iter().enumerate().skip(first) {
         let face = scene.geometric_normal_unnormalized(i);
         let m = &scene.materials[t.material as usize];
         let reflect = if m.kind.reflects() { m.reflect_blend.clamp(0.0, 1.0) } else { 0.0 };

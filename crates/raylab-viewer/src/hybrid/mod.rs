@@ -12,6 +12,8 @@ use std::time::Instant;
 
 use composite::CompositePass;
 use gbuffer::GBufferPass;
+use raylab_core::scene::Scene;
+use raylab_scene::animation::Animation;
 use readback::Readback;
 
 use crate::compositor::Compositor;
@@ -25,6 +27,17 @@ struct InFlight {
     slot: usize,
     job: Job,
     raster_ms: f64,
+    animation_time: Option<f64>,
+}
+
+/// The animation switch in hybrid mode: the rasteriser's own copy of the scene with its moving objects
+/// (built exactly as the worker builds its copy, so triangle and material ids agree).
+struct Moving {
+    source: Arc<LoadedScene>,
+    scene: Scene,
+    anim: Animation,
+    start: Instant,
+    first_moving: usize,
 }
 
 /// The GPU side of the hybrid mode: raster pass, readback and composite, and the scene they were given.
@@ -33,6 +46,7 @@ pub struct HybridGpu {
     readback: Readback,
     composite: CompositePass,
     scene: Option<Arc<LoadedScene>>,
+    moving: Option<Moving>,
     in_flight: VecDeque<InFlight>,
 }
 
@@ -44,6 +58,7 @@ impl HybridGpu {
             readback: Readback::default(),
             composite: CompositePass::new(device),
             scene: None,
+            moving: None,
             in_flight: VecDeque::new(),
         }
     }
@@ -53,6 +68,22 @@ impl HybridGpu {
     /// readback).
     pub fn step(&mut self, gpu: &Gpu, lab: &mut Lab) {
         let scene = &lab.scene_arc();
+        let animate = lab.settings.animate;
+        if self.moving.as_ref().is_some_and(|m| !animate || !Arc::ptr_eq(&m.source, scene)) {
+            // The animation stopped (or the scene changed): upload the still scene again.
+            self.moving = None;
+            self.scene = None;
+        }
+        if animate && self.moving.is_none() {
+            let (moving, anim) = Animation::add_movers(&scene.scene);
+            self.gbuffer.set_scene(&gpu.device, &gpu.queue, &moving);
+            self.composite.set_scene(&gpu.queue, &moving);
+            let first_moving = scene.scene.triangle_count();
+            self.moving =
+                Some(Moving { source: Arc::clone(scene), scene: moving, anim, start: Instant::now(), first_moving });
+            self.scene = Some(Arc::clone(scene));
+            self.in_flight.clear();
+        }
         if self.scene.as_ref().is_none_or(|s| !Arc::ptr_eq(s, scene)) {
             self.gbuffer.set_scene(&gpu.device, &gpu.queue, &scene.scene);
             self.composite.set_scene(&gpu.queue, &scene.scene);
@@ -63,6 +94,15 @@ impl HybridGpu {
             && let Some(job) = lab.hybrid_request()
         {
             let t0 = Instant::now();
+            let mut animation_time = None;
+            if let Some(m) = &mut self.moving {
+                let t = m.start.elapsed().as_secs_f64();
+                if let Err(e) = m.anim.apply(&mut m.scene, t as f32) {
+                    lab.message(e, true);
+                }
+                self.gbuffer.update_triangles(&gpu.queue, &m.scene, m.first_moving);
+                animation_time = Some(t);
+            }
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });
             let near = 1e-4 * job.scene.scene.bounds().diagonal().max(f32::MIN_POSITIVE);
@@ -72,7 +112,7 @@ impl HybridGpu {
             if let Some(slot) = slot {
                 self.readback.map(slot);
                 let raster_ms = t0.elapsed().as_secs_f64() * 1e3;
-                self.in_flight.push_back(InFlight { slot, job, raster_ms });
+                self.in_flight.push_back(InFlight { slot, job, raster_ms, animation_time });
             }
         }
         if lab.hybrid_idle()
@@ -89,6 +129,7 @@ impl HybridGpu {
                             gbuffer,
                             raster_ms: f.raster_ms,
                             readback_ms,
+                            animation_time: f.animation_time,
                         });
                     }
                 }
