@@ -150,16 +150,21 @@ impl Readouts {
         self.ui_frames.len()
     }
 
-    /// The top-right corner: FPS and frame time.
+    /// The top-right corner: FPS and frame time (in hybrid mode, of the CPU part: raster, readback, trace).
     pub fn corner(&self, ui: &mut egui::Ui, latest: Option<&Rendered>) {
         match latest {
             Some(r) => {
                 let ms = r.wall_s * 1e3;
                 ui.monospace(format!("{:6.1} FPS  {:7.2} ms", 1e3 / ms.max(1e-6), ms));
-                ui.monospace(format!(
-                    "{} {}x{}  {}x{} px",
-                    r.settings.trace.method, r.settings.tile, r.settings.tile, r.frame.width, r.frame.height
-                ));
+                let (w, h) = (r.frame.width, r.frame.height);
+                if r.hybrid.is_some() {
+                    ui.monospace(format!("hybrid, {} reflections  {w}x{h} px", r.settings.hybrid.method));
+                } else {
+                    ui.monospace(format!(
+                        "{} {}x{}  {w}x{h} px",
+                        r.settings.trace.method, r.settings.tile, r.settings.tile
+                    ));
+                }
             }
             None => {
                 ui.monospace("tracing the first frame...");
