@@ -2,7 +2,7 @@
 # Regenerates the hybrid-mode section of docs/BENCHMARKS.md (seed 003, Stokes 2014, Figures 8-10): the viewer
 # offscreen in hybrid mode (GPU G-buffer, CPU reflections, GPU composite) at 1280x720, median milliseconds per
 # stage over FRAMES frames, (a) against the G-buffer resolution, (b) against the triangle count (the built-in
-# scenes and the shared Sponza), (c) with synchronous and asynchronous readback and with interlacing. Run it on
+# scenes and the shared Sponza, each with the animation's moving mirror and ball), (c) with synchronous and asynchronous readback and with interlacing. Run it on
 # a committed tree; it needs a Vulkan driver (apt-get install mesa-vulkan-drivers libvulkan1).
 #
 #   scripts/hybrid.sh                 # 40 frames per row
@@ -44,8 +44,9 @@ print(f"| {sys.argv[2]} | {d['scene']} | {d['triangles']} | {s['gbuffer_percent'
 PY
 }
 for pct in 25 50 100; do row "(a) resolution" --scene atrium --gbuffer-percent "$pct"; done
-for scene in arena kitchen atrium forest; do row "(b) triangles" --scene "$scene"; done
-row "(b) triangles" "${sponza[@]}"
+# The animation adds a spinning mirror and a bouncing ball to every scene, so each has reflections in view.
+for scene in arena kitchen atrium forest; do row "(b) triangles" --scene "$scene" --animate; done
+row "(b) triangles" "${sponza[@]}" --animate
 row "(c) readback" --scene atrium --sync-readback
 row "(c) readback" --scene atrium
 for k in 2 4; do row "(c) interlacing" --scene atrium --interlace "$k"; done
