@@ -1,7 +1,7 @@
 //! Dividing a set of triangle references in two, in place (Mora 2011's primitive subdivision): on the longest
 //! axis of the triangles' centres, either at the median centre (Stokes's thesis, section 3.3) or at the best of
-//! [`BINS`] equal-width bins by the surface area heuristic (as Afra 2012 and BVH builders do). Each half's box
-//! and centre box come out of the same passes, so a node costs two passes over its triangles.
+//! [`BINS`] equal-width bins by the surface area heuristic (as Afra 2012 and BVH builders do). With SAH each
+//! half's box and centre box are the unions of its bins, so a node costs two passes over its triangles.
 
 use serde::{Deserialize, Serialize};
 
@@ -75,22 +75,18 @@ pub(super) fn divide(tris: &mut [TriRecord], b: &SetBounds, rule: SplitRule) -> 
         2
     };
     let (lo, width) = (b.centres.min[axis], extent[axis]);
-    let mid = if !(width > 0.0 && width.is_finite()) {
-        None
-    } else {
-        match rule {
-            SplitRule::Median => {
-                let mid = n / 2;
-                tris.select_nth_unstable_by(mid, |a, b| a.centre2(axis).total_cmp(&b.centre2(axis)));
-                Some(mid)
-            }
-            SplitRule::Sah => sah_partition(tris, b, axis, lo, width),
-        }
-    };
-    let mid = match mid {
-        Some(m) if m > 0 && m < n => m,
-        _ => n / 2,
-    };
+    let measurable = width > 0.0 && width.is_finite();
+    if measurable
+        && rule == SplitRule::Sah
+        && let Some(s) = sah_partition(tris, b, axis, lo, width)
+    {
+        return Some(s);
+    }
+    // The median, or the middle of the list when all centres fall in one bin.
+    let mid = n / 2;
+    if measurable && rule == SplitRule::Median {
+        tris.select_nth_unstable_by(mid, |a, b| a.centre2(axis).total_cmp(&b.centre2(axis)));
+    }
     let (first, second) = tris.split_at(mid);
     Some(Split { mid, axis, first: SetBounds::of(first), second: SetBounds::of(second) })
 }
@@ -100,11 +96,11 @@ fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
     (((c - lo) * scale) as usize).min(BINS - 1)
 }
 
-/// Bins `tris` on `axis`, picks the cheapest boundary by the SAH and partitions at it; returns the size of
-/// the first half.
-fn sah_partition(tris: &mut [TriRecord], b: &SetBounds, axis: usize, lo: f32, width: f32) -> Option<usize> {
+/// Bins `tris` on `axis`, picks the cheapest boundary by the SAH and partitions at it; the halves' bounds
+/// are the unions of their bins. `None` when every triangle falls in one bin.
+fn sah_partition(tris: &mut [TriRecord], b: &SetBounds, axis: usize, lo: f32, width: f32) -> Option<Split> {
     let scale = BINS as f32 / width;
-    let mut bins = [SetBounds { bounds: crate::aabb::Aabb::EMPTY, centres: crate::aabb::Aabb::EMPTY }; BINS];
+    let mut bins = [EMPTY_SET; BINS];
     let mut counts = [0u32; BINS];
     for t in tris.iter() {
         let k = bin_of(t.centre2(axis), lo, scale);
@@ -139,8 +135,13 @@ fn sah_partition(tris: &mut [TriRecord], b: &SetBounds, axis: usize, lo: f32, wi
         }
     }
     let (bin, _) = best?;
-    Some(partition(tris, |t| bin_of(t.centre2(axis), lo, scale) <= bin))
+    let mid = partition(tris, |t| bin_of(t.centre2(axis), lo, scale) <= bin);
+    let union = |r: std::ops::Range<usize>| bins[r].iter().fold(EMPTY_SET, |a, &b| a.union(b));
+    Some(Split { mid, axis, first: union(0..bin + 1), second: union(bin + 1..BINS) })
 }
+
+/// Bounds of no triangle.
+const EMPTY_SET: SetBounds = SetBounds { bounds: crate::aabb::Aabb::EMPTY, centres: crate::aabb::Aabb::EMPTY };
 
 /// Moves the triangles for which `first` holds to the front (two cursors, each element moved at most once);
 /// returns how many there are.
