@@ -142,6 +142,7 @@ impl Dacrt {
         stats.packets += scratch.rays.len() as u64;
         if !scratch.rays.is_empty() && !self.refs.is_empty() {
             let mut walk = Walk {
+                soup: &self.soup,
                 params: *p,
                 answer,
                 flags: std::mem::take(&mut scratch.flags),

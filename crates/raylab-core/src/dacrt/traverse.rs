@@ -12,6 +12,7 @@ use super::split::divide;
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
 use crate::ray::Hit;
 use crate::stats::TraversalStats;
+use crate::triangle::TriangleSoup;
 
 /// Depth past which nodes are leaves whatever their size; the median and middle-of-list cuts keep real
 /// recursions far shallower (a lopsided SAH cut still removes one bin's worth of triangles).
@@ -24,7 +25,7 @@ const ORDER_SAMPLES: usize = 16;
 /// a packet at once with the watertight test, bit for bit what the single-ray test reports.
 pub(super) trait Answer {
     /// Tests every ray of `rays` against every triangle of `tris`, updating the rays' intervals.
-    fn leaf<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &[TriRecord]);
+    fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]);
 }
 
 /// Four rays (or fewer, at the end) in a temporary packet.
@@ -45,11 +46,11 @@ pub(super) struct Closest<'a> {
 }
 
 impl Answer for Closest<'_> {
-    fn leaf<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &[TriRecord]) {
+    fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]) {
         for (group, p) in packets::<V>(rays) {
             let mut hits = PacketHits::new(&p);
             for t in tris {
-                intersect_packet(&p, &mut hits, &t.v, t.id, p.valid);
+                intersect_packet(&p, &mut hits, soup.get(t.id), t.id, p.valid);
             }
             let found = hits.to_hits();
             for (r, h) in group.iter_mut().zip(found) {
@@ -66,11 +67,11 @@ impl Answer for Closest<'_> {
 }
 
 /// The lanes of packet `p` that some triangle of `tris` blocks, and for each lane the first such triangle.
-fn blocked<V: Vf32>(p: &RayPacket<V>, tris: &[TriRecord]) -> (u32, [u32; 4]) {
+fn blocked<V: Vf32>(p: &RayPacket<V>, soup: &TriangleSoup, tris: &[TriRecord]) -> (u32, [u32; 4]) {
     let mut open = p.valid;
     let mut first = [u32::MAX; 4];
     for t in tris {
-        let hit = occlude_packet(p, &t.v, open);
+        let hit = occlude_packet(p, soup.get(t.id), open);
         if hit.any() {
             let bits = hit.bits();
             for (k, f) in first.iter_mut().enumerate() {
@@ -93,9 +94,9 @@ pub(super) struct Any<'a> {
 }
 
 impl Answer for Any<'_> {
-    fn leaf<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &[TriRecord]) {
+    fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]) {
         for (group, p) in packets::<V>(rays) {
-            let (bits, _) = blocked(&p, tris);
+            let (bits, _) = blocked(&p, soup, tris);
             for (k, r) in group.iter_mut().enumerate() {
                 if bits >> k & 1 == 1 {
                     self.out[r.id as usize] = true;
@@ -112,9 +113,9 @@ pub(super) struct Blocker<'a> {
 }
 
 impl Answer for Blocker<'_> {
-    fn leaf<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &[TriRecord]) {
+    fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]) {
         for (group, p) in packets::<V>(rays) {
-            let (bits, first) = blocked(&p, tris);
+            let (bits, first) = blocked(&p, soup, tris);
             for (k, r) in group.iter_mut().enumerate() {
                 if bits >> k & 1 == 1 {
                     self.out[r.id as usize] = Some(first[k]);
@@ -126,7 +127,8 @@ impl Answer for Blocker<'_> {
 }
 
 /// One recursion's shared state.
-pub(super) struct Walk<A> {
+pub(super) struct Walk<'a, A> {
+    pub soup: &'a TriangleSoup,
     pub params: DacrtParams,
     pub answer: A,
     /// Scratch flags for the filter.
@@ -134,7 +136,7 @@ pub(super) struct Walk<A> {
     pub stats: TraversalStats,
 }
 
-impl<A: Answer> Walk<A> {
+impl<A: Answer> Walk<'_, A> {
     /// Traces `rays` against `tris` (bounded by `b`).
     pub fn recurse<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &mut [TriRecord], b: SetBounds, depth: u32) {
         self.stats.nodes += 1;
@@ -144,7 +146,7 @@ impl<A: Answer> Walk<A> {
         let Some(s) = split else {
             self.stats.leaves += 1;
             self.stats.isect_tests += (rays.len() * tris.len()) as u64;
-            self.answer.leaf::<V>(rays, tris);
+            self.answer.leaf::<V>(self.soup, rays, tris);
             return;
         };
         let step = rays.len().div_ceil(ORDER_SAMPLES);
