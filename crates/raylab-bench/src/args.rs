@@ -273,6 +273,7 @@ impl MethodArgs {
                 leaf_tris: self.dacrt_leaf_tris as usize,
                 split: self.dacrt_split,
             },
+            stream_group: None,
         }
     }
 }

@@ -86,6 +86,9 @@ fn bad_input_is_refused_with_a_clear_error() {
         (&["trace", "--scene", "arena", "--threads", "0"], "1..=1024"),
         (&["trace", "--scene", "arena", "--kd-cisect", "-1"], "c_isect"),
         (&["trace", "--scene", "arena", "--kd-empty-bonus", "1"], "empty_bonus"),
+        (&["trace", "--scene", "arena", "--method", "mbvh-rs", "--group", "100"], "power of two from 16 to 4096"),
+        (&["trace", "--scene", "arena", "--method", "mbvh-rs", "--group", "8192"], "power of two from 16 to 4096"),
+        (&["trace", "--scene", "arena", "--method", "mbvh", "--group", "64"], "--method mbvh-rs"),
     ];
     for (args, needle) in cases {
         let o = bench(args, dir.path());
@@ -282,9 +285,41 @@ fn distribution_prints_per_bounce_speeds_for_each_method() {
     for want in ["| mono |", "| packet |", "| mbvh |", "| mbvh-rs | 64 |", "| mbvh-rs | 16 |", "bounce 2"] {
         assert!(out.contains(want), "missing '{want}' in:\n{out}");
     }
+    // The paper's figures, each its own table: counters per bounce for reflection and shadow rays apart, and
+    // the leaf SIMD use against the group size (the sweep's groups and the default one, in order).
+    for want in ["**Figure 4**", "**Figure 5**", "**Figure 6**", "**Figures 7-8**", "| mbvh | - | shadow |"] {
+        assert!(out.contains(want), "missing '{want}' in:\n{out}");
+    }
+    let sweep = out.split("**Figures 7-8**").nth(1).unwrap();
+    let groups: Vec<&str> = sweep.lines().filter_map(|l| l.strip_prefix("| ")?.split(' ').next()).collect();
+    assert_eq!(groups[1..], ["16", "64"], "{sweep}");
     assert!(dir.path().join("d.png").is_file());
     let o = bench(&["distribution", "--scene", "arena", "--bounces", "9"], dir.path());
     assert!(!o.status.success() && stderr(&o).contains("1..=7"));
+}
+
+#[test]
+fn mbvh_rs_groups_cut_from_tiles_give_the_same_hits() {
+    let dir = tempfile::tempdir().unwrap();
+    for kind in ["diffuse", "shadow"] {
+        let sum = |extra: &[&str]| {
+            let mut args = vec!["trace", "--scene", "kitchen", "--width", "40", "--height", "40", "--kind", kind];
+            args.extend_from_slice(extra);
+            args.extend_from_slice(&["--reps", "1", "--json"]);
+            let o = bench(&args, dir.path());
+            assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+            let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            (v["result"]["hits"].as_u64().unwrap(), v["result"]["sum_t"].as_f64().unwrap(), v)
+        };
+        let (hits, sum_t, _) = sum(&["--method", "mono"]);
+        assert!(hits > 0, "{kind}");
+        for group in ["16", "32", "256", "2048"] {
+            let (h, t, v) = sum(&["--method", "mbvh-rs", "--group", group]);
+            assert_eq!((h, t), (hits, sum_t), "{kind}, group {group}");
+            assert_eq!(v["group"].as_u64().unwrap().to_string(), group);
+            assert!(v["tile"].as_u64().unwrap().pow(2) >= v["group"].as_u64().unwrap(), "{v}");
+        }
+    }
 }
 
 #[test]

@@ -9,6 +9,7 @@ use clap::Args;
 use raylab_core::distribution::{Accumulator, BounceStats, DistributionSettings, render_pass};
 use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
+use raylab_core::stats::TraversalStats;
 use raylab_core::trace::{TraceOptions, Tracer};
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_non_negative};
@@ -61,12 +62,17 @@ pub struct DistributionArgs {
     /// Also write the markdown tables to this file.
     #[arg(long)]
     markdown: Option<PathBuf>,
+    /// Write only the speed table (Figures 2-3), headed by the scene, for comparing scenes.
+    #[arg(long)]
+    speeds_only: bool,
 }
 
 /// Runs the command.
 pub fn run(a: &DistributionArgs) -> Result<(), String> {
     let env = Environment::detect();
-    let (scene, _) = load_scene(&a.scene.source())?;
+    let source = a.scene.source();
+    let scene_name = a.scene.scene.clone();
+    let (scene, _) = load_scene(&source)?;
     let (mut camera, light) = a.scene.camera_and_light(&scene)?;
     camera.aperture = a.aperture;
     let light = light.soft();
@@ -96,8 +102,9 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
     let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
     let _ = writeln!(
         md,
-        "\n{}x{}, {} paths per pixel, {} bounces, {}, Phong exponent {}, {} thread(s); Mrays/s of closest-hit rays \
-         (shadow rays in their own column), per thread.\n",
+        "\n{}: {}x{}, {} paths per pixel, {} bounces, {}, Phong exponent {}, {} thread(s); speeds are per \
+         thread (rays over thread-summed seconds).\n",
+        scene_name,
         a.width,
         a.height,
         a.spp,
@@ -106,47 +113,21 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
         a.glossy_exponent,
         a.threads
     );
-    let _ = write!(md, "| method | group |");
-    for b in 0..=a.bounces {
-        let _ = write!(md, " bounce {b} |");
-    }
-    let _ = writeln!(md, " shadow | box tests/ray | node fetches/ray | triangle tests/ray | leaf SIMD use 4/8/16 |");
-    let _ = writeln!(md, "|---|---:|{}", "---:|".repeat(a.bounces as usize + 6));
     let group = |tile: u64| tile * tile * a.spp;
     let mut first_image = None;
-    let mut rows: Vec<(Method, u64)> = a.methods.iter().map(|&m| (m, a.tile)).collect();
-    rows.extend(a.groups.iter().map(|&t| (Method::MbvhRs, t)));
-    for (method, tile) in rows {
+    let mut rows: Vec<(Method, u64, bool)> = a.methods.iter().map(|&m| (m, a.tile, false)).collect();
+    rows.extend(a.groups.iter().map(|&t| (Method::MbvhRs, t, true)));
+    let mut runs: Vec<Run> = Vec::with_capacity(rows.len());
+    for (method, tile, sweep) in rows {
         eprintln!("tracing with {method}, tile {tile}");
-        let (stats, acc, _) = run_one(method, tile);
-        let _ = write!(
-            md,
-            "| {method} | {} |",
-            if method == Method::MbvhRs { group(tile).to_string() } else { "-".into() }
-        );
-        let mut total = raylab_core::stats::TraversalStats::default();
-        let (mut shadow_rays, mut shadow_s) = (0u64, 0f64);
-        for b in &stats {
-            let _ = write!(md, " {:.2} |", b.rays as f64 / b.seconds.max(1e-12) / 1e6);
-            total += b.stats;
-            shadow_rays += b.shadow_rays;
-            shadow_s += b.shadow_seconds;
-        }
-        let per_ray = |x: u64| x as f64 / total.rays.max(1) as f64;
-        let u = total.leaf_utilisation();
-        let _ = writeln!(
-            md,
-            " {:.2} | {:.2} | {:.2} | {:.2} | {} |",
-            shadow_rays as f64 / shadow_s.max(1e-12) / 1e6,
-            per_ray(total.box_tests),
-            per_ray(total.nodes),
-            per_ray(total.isect_tests),
-            if total.leaf_rays > 0 { format!("{:.0}% / {:.0}% / {:.0}%", u[0], u[1], u[2]) } else { "-".into() }
-        );
+        let (bounces, acc, _) = run_one(method, tile);
+        let group = (method == Method::MbvhRs).then(|| group(tile));
+        runs.push(Run { method, group, sweep, bounces });
         if first_image.is_none() {
             first_image = Some(acc);
         }
     }
+    write_tables(&mut md, &runs, a.bounces as usize, a.speeds_only);
     print!("{md}");
     if let Some(p) = &a.markdown {
         std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
@@ -158,4 +139,124 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
             .map_err(|e| format!("--out: cannot write {}: {e}", out.display()))?;
     }
     Ok(())
+}
+
+/// One method's pass: its MBVH RS group size (`None` for other methods) and the work per bounce.
+struct Run {
+    method: Method,
+    group: Option<u64>,
+    /// A row of the `--groups` sweep (shown only in the speed table and Figures 7-8).
+    sweep: bool,
+    bounces: Vec<BounceStats>,
+}
+
+impl Run {
+    fn label(&self) -> String {
+        match self.group {
+            Some(g) => format!("{} | {g}", self.method),
+            None => format!("{} | -", self.method),
+        }
+    }
+}
+
+/// A counter table: its title, the counter, and whether only MBVH methods have it.
+type Counter = (&'static str, fn(&TraversalStats) -> u64, bool);
+
+/// The paper's Figures 2-8 as tables: speeds per bounce, then the counters per bounce for closest-hit
+/// (reflection) and shadow rays apart, then the leaf SIMD use against the group size.
+fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: bool) {
+    let bounce_header = |md: &mut String, first: &str| {
+        let _ = write!(md, "| {first} |");
+        for b in 0..=bounces {
+            let _ = write!(md, " bounce {b} |");
+        }
+    };
+    let rate = |rays: u64, s: f64| rays as f64 / s.max(1e-12) / 1e6;
+
+    let _ = writeln!(md, "**Figures 2-3**: Mrays/s per bounce (bounce 0: camera rays) and of the shadow rays.\n");
+    bounce_header(md, "method | group");
+    let _ = writeln!(md, " shadow | all rays |");
+    let _ = writeln!(md, "|---|---:|{}", "---:|".repeat(bounces + 3));
+    for r in runs {
+        let _ = write!(md, "| {} |", r.label());
+        for b in &r.bounces {
+            let _ = write!(md, " {:.2} |", rate(b.rays, b.seconds));
+        }
+        let sum = |f: fn(&BounceStats) -> f64| r.bounces.iter().map(f).sum::<f64>();
+        let (shadow_rays, shadow_s) = (sum(|b| b.shadow_rays as f64), sum(|b| b.shadow_seconds));
+        let (rays, secs) = (sum(|b| b.rays as f64), sum(|b| b.seconds));
+        let _ = writeln!(
+            md,
+            " {:.2} | {:.2} |",
+            rate(shadow_rays as u64, shadow_s),
+            rate((rays + shadow_rays) as u64, secs + shadow_s)
+        );
+    }
+
+    if speeds_only {
+        return;
+    }
+    let counters: [Counter; 3] = [
+        (
+            "**Figure 4**: SIMD box tests per ray (MBVH methods; kd-tree methods test split planes, not boxes).",
+            |s| s.box_tests,
+            true,
+        ),
+        (
+            "**Figure 5**: node fetches per ray (MBVH RS fetches a node once per group; kd-tree methods count nodes visited, once per packet for packets).",
+            |s| s.nodes,
+            false,
+        ),
+        (
+            "**Figure 6**: primitive tests per ray (SIMD tests for packets and MBVH RS leaf packets).",
+            |s| s.isect_tests,
+            false,
+        ),
+    ];
+    for (title, counter, mbvh_only) in counters {
+        let _ = writeln!(md, "\n{title}\n");
+        bounce_header(md, "method | group | rays");
+        let _ = writeln!(md);
+        let _ = writeln!(md, "|---|---:|---|{}", "---:|".repeat(bounces + 1));
+        for r in runs.iter().filter(|r| !r.sweep && (!mbvh_only || r.method.uses_mbvh())) {
+            for (kind, pick) in [("reflection", 0), ("shadow", 1)] {
+                let _ = write!(md, "| {} | {kind} |", r.label());
+                for b in &r.bounces {
+                    let s = if pick == 0 { &b.stats } else { &b.shadow_stats };
+                    let _ = write!(md, " {:.2} |", counter(s) as f64 / s.rays.max(1) as f64);
+                }
+                let _ = writeln!(md);
+            }
+        }
+    }
+
+    let sweep: Vec<&Run> = runs.iter().filter(|r| r.method == Method::MbvhRs).collect();
+    if !sweep.is_empty() {
+        let _ = writeln!(
+            md,
+            "\n**Figures 7-8**: SIMD use of MBVH RS leaf packets (active rays over packet lanes, closest-hit and shadow rays of all bounces) against the ray-group size, at the 4 lanes traced here and at 8 and 16 lanes.\n"
+        );
+        let _ = writeln!(md, "| group | 4 lanes | 8 lanes | 16 lanes | node fetches/ray |");
+        let _ = writeln!(md, "|---:|---:|---:|---:|---:|");
+        let mut sweep = sweep;
+        sweep.sort_by_key(|r| r.group);
+        sweep.dedup_by_key(|r| r.group);
+        for r in sweep {
+            let mut total = TraversalStats::default();
+            for b in &r.bounces {
+                total += b.stats;
+                total += b.shadow_stats;
+            }
+            let u = total.leaf_utilisation();
+            let _ = writeln!(
+                md,
+                "| {} | {:.0}% | {:.0}% | {:.0}% | {:.2} |",
+                r.group.unwrap_or(0),
+                u[0],
+                u[1],
+                u[2],
+                total.nodes as f64 / total.rays.max(1) as f64
+            );
+        }
+    }
 }

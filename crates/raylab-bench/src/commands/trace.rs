@@ -46,9 +46,23 @@ pub struct TraceArgs {
     /// Rays checked against the brute-force reference before any speed is reported (0 skips the check).
     #[arg(long, default_value_t = 256, value_parser = in_range(0, 1_000_000))]
     validate: u64,
+    /// MBVH RS ray-group size, a power of two from 16 to 4096 (the paper's 2^4..2^12; default: one group per
+    /// tile). Groups are cut from each tile along the Z-order curve; the tile grows to hold at least one group.
+    #[arg(long, value_parser = parse_group)]
+    group: Option<u64>,
     /// Print one JSON object on stdout and nothing else.
     #[arg(long)]
     json: bool,
+}
+
+/// Parses `--group`: a power of two in 2^4..=2^12.
+fn parse_group(s: &str) -> Result<u64, String> {
+    let g: u64 = s.parse().map_err(|_| format!("'{s}' is not a whole number"))?;
+    if g.is_power_of_two() && (16..=4096).contains(&g) {
+        Ok(g)
+    } else {
+        Err(format!("{g} is not a power of two from 16 to 4096"))
+    }
 }
 
 /// Runs the command.
@@ -63,7 +77,18 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         WorkloadBuilder::new(&scene, &camera, light.position, w, h, &tree).seed(a.seed)
     });
     let workload = builder.build(a.kind);
-    let options = a.m.options();
+    let mut options = a.m.options();
+    let mut tile = a.m.tile;
+    if let Some(g) = a.group {
+        if options.method != raylab_core::method::Method::MbvhRs {
+            return Err(format!("--group sets the ray group of --method mbvh-rs, not of {}", options.method));
+        }
+        options.stream_group = Some(g as usize);
+        // The smallest power-of-two tile that holds a whole group.
+        while tile * tile < g {
+            tile *= 2;
+        }
+    }
     let mbvh = options.method.uses_mbvh().then(|| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string());
         pool.map(|p| with_spinner("building MBVH", || p.install(|| Mbvh::build(&scene))))
@@ -78,7 +103,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         tracer = tracer.with_dacrt(d);
     }
     let (report, results) =
-        measure(&tracer, &workload, a.m.tile as u32, a.threads as usize, a.warmup as usize, a.reps as usize)?;
+        measure(&tracer, &workload, tile as u32, a.threads as usize, a.warmup as usize, a.reps as usize)?;
     let checked = with_spinner("validating against brute force", || {
         validate(&reference, &workload, &results, a.validate as usize)
     })
@@ -93,7 +118,8 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
             "width": w,
             "height": h,
             "method": a.m.method,
-            "tile": a.m.tile,
+            "tile": tile,
+            "group": a.group,
             "cull": options.cull,
             "backend": options.backend.name(),
             "kd_build_seconds": tree.build_time().as_secs_f64(),
@@ -117,10 +143,11 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     println!("validated        {checked} rays against brute force");
     let what = if a.kind.is_occlusion() { "occluded" } else { "hits" };
     println!(
-        "{} {} tile {} cull {} backend {} threads {}: rays {}, {} {}, sum_t {:.6}",
+        "{} {} tile {}{} cull {} backend {} threads {}: rays {}, {} {}, sum_t {:.6}",
         a.kind,
         a.m.method,
-        a.m.tile,
+        tile,
+        a.group.map(|g| format!(" group {g}")).unwrap_or_default(),
         options.cull,
         options.backend.name(),
         report.threads,

@@ -65,6 +65,8 @@ pub struct BounceStats {
     pub shadow_seconds: f64,
     /// Counters of the closest-hit rays.
     pub stats: TraversalStats,
+    /// Counters of the shadow rays.
+    pub shadow_stats: TraversalStats,
 }
 
 /// A progressively refined image: linear colour sums and the number of passes in them.
@@ -124,6 +126,7 @@ pub fn render_pass(
             a.seconds += b.seconds;
             a.shadow_seconds += b.shadow_seconds;
             a.stats += b.stats;
+            a.shadow_stats += b.shadow_stats;
         }
     }
     acc.paths += settings.spp.max(1);
@@ -199,9 +202,8 @@ impl Pass<'_> {
             }
             let t1 = Instant::now();
             blocked.iter_mut().for_each(|x| *x = false);
-            let mut shadow_stats = TraversalStats::default();
             if shadow.iter().any(Option::is_some) {
-                self.tracer.occluded_tile(&shadow, lw, lh, None, &mut blocked, &mut shadow_stats);
+                self.tracer.occluded_tile(&shadow, lw, lh, None, &mut blocked, &mut b.shadow_stats);
             }
             b.shadow_seconds = t1.elapsed().as_secs_f64();
             b.shadow_rays = shadow.iter().filter(|r| r.is_some()).count() as u64;

@@ -18,6 +18,7 @@ use crate::packet::{Cone, Cone4};
 use crate::packet::{Frustum, PacketTile};
 use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
+use crate::render::RayOrder;
 use crate::shadow::EdgeWidth;
 use crate::stats::TraversalStats;
 
@@ -40,6 +41,10 @@ pub struct TraceOptions {
     pub stream_order: bool,
     /// DACRT's leaf thresholds and split rule.
     pub dacrt: DacrtParams,
+    /// MBVH RS ray-group size: `None` traces each tile as one group; `Some(g)` cuts a tile into groups of `g`
+    /// rays along the Z-order curve (square or 2:1 blocks of pixels for powers of two), the paper's 2^4 to
+    /// 2^12 sweep independent of the tile size.
+    pub stream_group: Option<usize>,
 }
 
 fn backend_name<S: serde::Serializer>(b: &Backend, s: S) -> Result<S::Ok, S::Error> {
@@ -60,6 +65,7 @@ impl Default for TraceOptions {
             shadow_spread_limit: Self::SHADOW_SPREAD_LIMIT,
             stream_order: true,
             dacrt: DacrtParams::default(),
+            stream_group: None,
         }
     }
 }
@@ -194,7 +200,9 @@ impl<'a> Tracer<'a> {
                     *o = r.and_then(|r| m.intersect(&r, stats));
                 }
             }
-            Method::MbvhRs => self.mbvh().intersect_stream(rays, out, self.options.stream_order, stats),
+            Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
+                self.mbvh().intersect_stream(r, o, self.options.stream_order, stats)
+            }),
             Method::Dacrt => self.dacrt().intersect(&self.options.dacrt, rays, out, stats),
             _ => match self.options.backend {
                 #[cfg(target_arch = "x86_64")]
@@ -233,13 +241,47 @@ impl<'a> Tracer<'a> {
                     *o = r.is_some_and(|r| m.occluded(&r, stats));
                 }
             }
-            Method::MbvhRs => self.mbvh().occluded_stream(rays, out, self.options.stream_order, stats),
+            Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
+                self.mbvh().occluded_stream(r, o, self.options.stream_order, stats)
+            }),
             Method::Dacrt => self.dacrt().occluded(&self.options.dacrt, rays, out, stats),
             _ => match self.options.backend {
                 #[cfg(target_arch = "x86_64")]
                 Backend::Sse => self.occluded_simd::<raylab_simd::sse::F32x4>(rays, width, height, toward, out, stats),
                 _ => self.occluded_simd::<raylab_simd::scalar::F32x4>(rays, width, height, toward, out, stats),
             },
+        }
+    }
+
+    /// Calls `trace(rays, out)` on the whole tile, or on groups of [`TraceOptions::stream_group`] rays taken
+    /// along the Z-order curve of the `width x height` tile.
+    fn in_groups<T: Copy + Default>(
+        &self,
+        rays: &[Option<Ray>],
+        width: usize,
+        height: usize,
+        out: &mut [T],
+        mut trace: impl FnMut(&[Option<Ray>], &mut [T]),
+    ) {
+        let group = self.options.stream_group.unwrap_or(usize::MAX).max(1);
+        if rays.len() <= group {
+            return trace(rays, out);
+        }
+        let order: Vec<usize> = RayOrder::Morton
+            .offsets(width as u32, height as u32)
+            .into_iter()
+            .map(|(x, y)| y as usize * width + x as usize)
+            .collect();
+        let (mut part_rays, mut part_out) = (Vec::with_capacity(group), Vec::with_capacity(group));
+        for chunk in order.chunks(group) {
+            part_rays.clear();
+            part_rays.extend(chunk.iter().map(|&i| rays[i]));
+            part_out.clear();
+            part_out.resize(chunk.len(), T::default());
+            trace(&part_rays, &mut part_out);
+            for (&i, &o) in chunk.iter().zip(&part_out) {
+                out[i] = o;
+            }
         }
     }
 
