@@ -277,3 +277,13 @@ impl MethodArgs {
         }
     }
 }
+
+/// Parses an MBVH RS ray-group size: a power of two in 2^4..=2^12 (the MBVH RS paper's range).
+pub fn parse_group(s: &str) -> Result<u64, String> {
+    let g: u64 = s.parse().map_err(|_| format!("'{s}' is not a whole number"))?;
+    if g.is_power_of_two() && (16..=4096).contains(&g) {
+        Ok(g)
+    } else {
+        Err(format!("{g} is not a power of two from 16 to 4096"))
+    }
+}

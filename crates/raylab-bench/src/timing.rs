@@ -15,6 +15,16 @@ use serde::Serialize;
 /// The tile edge the harness uses.
 pub const HARNESS_TILE: u32 = 16;
 
+/// The tile edge, `tile` or the smallest power-of-two multiple of it, whose tiles hold at least `group` rays
+/// (an MBVH RS ray group is cut from one tile).
+pub fn tile_for_group(tile: u32, group: u32) -> u32 {
+    let mut t = tile.max(1);
+    while t * t < group {
+        t *= 2;
+    }
+    t
+}
+
 /// Tile edge of DACRT's ray sets in the benchmarks: 65,536 rays a set, four sets for 512x512 (so two threads
 /// share the work); smaller sets repeat the division of the scene's triangles more often.
 pub const DACRT_SET_TILE: u32 = 256;

@@ -181,6 +181,20 @@ fn ray_streams_match_brute_force() {
         let mut rays: Vec<Option<Ray>> = incoherent(&scene, 4096, 23).into_iter().map(Some).collect();
         rays.extend(adversarial_rays(&scene, &kd, 200, 29).into_iter().map(Some));
         let total = rays.len() as u64;
+        let check = |label: &str, rays: &[Option<Ray>], hits: &[Option<raylab_core::ray::Hit>], blocked: &[bool]| {
+            for ((r, h), b) in rays.iter().zip(hits).zip(blocked) {
+                let r = r.unwrap();
+                let want = bf.intersect(&r, &mut TraversalStats::default());
+                match (h, want) {
+                    (Some(h), Some(w)) => assert!(
+                        (h.t - w.t).abs() <= 1e-5 * w.t.abs().max(1e-30),
+                        "{name} {label}: {r:?}: {h:?} vs {w:?}"
+                    ),
+                    (h, w) => assert_eq!(*h, w, "{name} {label}: {r:?}"),
+                }
+                assert_eq!(*b, bf.occluded(&r, &mut TraversalStats::default()), "{name} {label}: {r:?}");
+            }
+        };
         for (group, ordered) in [(16, true), (256, true), (256, false), (4096, true)] {
             let opts = TraceOptions { method: Method::MbvhRs, stream_order: ordered, ..TraceOptions::default() };
             let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
@@ -190,24 +204,31 @@ fn ray_streams_match_brute_force() {
                 let mut blocked = vec![false; chunk.len()];
                 tracer.intersect_tile(chunk, chunk.len(), 1, &mut hits, &mut s);
                 tracer.occluded_tile(chunk, chunk.len(), 1, None, &mut blocked, &mut s);
-                for ((r, h), b) in chunk.iter().zip(&hits).zip(&blocked) {
-                    let r = r.unwrap();
-                    let want = bf.intersect(&r, &mut TraversalStats::default());
-                    match (h, want) {
-                        (Some(h), Some(w)) => assert!(
-                            (h.t - w.t).abs() <= 1e-5 * w.t.abs().max(1e-30),
-                            "{name} group {group}: {r:?}: {h:?} vs {w:?}"
-                        ),
-                        (h, w) => assert_eq!(*h, w, "{name} group {group}: {r:?}"),
-                    }
-                    assert_eq!(*b, bf.occluded(&r, &mut TraversalStats::default()), "{name} group {group}: {r:?}");
-                }
+                check(&format!("group {group}"), chunk, &hits, &blocked);
             }
             assert_eq!(s.rays, 2 * total);
             assert!(s.box_tests > 0 && s.leaf_rays > 0);
             let u = s.leaf_utilisation();
             assert!(u[0] >= u[1] && u[1] >= u[2] && u[0] <= 100.0, "{u:?}");
         }
+        // Groups the tracer cuts from a 64x50 tile along the Z-order curve, odd powers of two (2:1 blocks) and a
+        // ragged last row included; every ray is traced exactly once.
+        let tile = &rays[..64 * 50];
+        let mut fetches = Vec::new();
+        for group in [16, 32, 512] {
+            let opts = TraceOptions { method: Method::MbvhRs, stream_group: Some(group), ..TraceOptions::default() };
+            let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
+            let mut s = TraversalStats::default();
+            let mut hits = vec![None; tile.len()];
+            let mut blocked = vec![false; tile.len()];
+            tracer.intersect_tile(tile, 64, 50, &mut hits, &mut s);
+            tracer.occluded_tile(tile, 64, 50, None, &mut blocked, &mut s);
+            check(&format!("tile cut into groups of {group}"), tile, &hits, &blocked);
+            assert_eq!(s.rays, 2 * tile.len() as u64);
+            fetches.push(s.nodes);
+        }
+        // Smaller groups share fewer node fetches: the tile really was cut.
+        assert!(fetches[0] > fetches[1] && fetches[1] > fetches[2], "{name}: {fetches:?}");
     }
 }
 

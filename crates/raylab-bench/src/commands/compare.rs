@@ -14,10 +14,10 @@ use raylab_core::reference::BruteForce;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 
-use crate::args::{KdArgs, SceneArgs, in_range};
+use crate::args::{KdArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene, with_spinner};
-use crate::timing::{DACRT_SET_TILE as DACRT_TILE, HARNESS_TILE, TraceReport, measure, validate};
+use crate::timing::{DACRT_SET_TILE as DACRT_TILE, HARNESS_TILE, TraceReport, measure, tile_for_group, validate};
 
 /// Compares raylab's single-ray kd-tree with Embree's single-ray API on the harness's rays.
 #[derive(Args, Debug)]
@@ -51,10 +51,12 @@ pub struct CompareArgs {
     #[arg(long, value_delimiter = ',', default_value = "packet,frustum,mft,cone,mft-cone")]
     methods: Vec<Method>,
     /// Methods to measure on the diffuse (incoherent) rays beside Embree's `rtcIntersect1` and
-    /// `rtcIntersect1M` (mbvh-rs traces each 16x16 tile as one group of 256 rays, dacrt each 256x256 tile as
-    /// one set).
+    /// `rtcIntersect1M` (mbvh-rs traces groups of `--rs-groups` rays, dacrt each 256x256 tile as one set).
     #[arg(long, value_delimiter = ',', default_value = "mbvh,mbvh-rs,dacrt")]
     incoherent: Vec<Method>,
+    /// MBVH RS ray-group sizes to measure, powers of two from 16 to 4096 (the paper's default is 256).
+    #[arg(long, value_delimiter = ',', default_value = "256,4096", value_parser = parse_group)]
+    rs_groups: Vec<u64>,
     /// Tile sizes for the frustum methods.
     #[arg(long, value_delimiter = ',', default_value = "4,8,16", value_parser = in_range(2, 256))]
     tiles: Vec<u64>,
@@ -184,7 +186,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     // Incoherent rays: the MBVH methods (MBVH RS paper) and DACRT (seed 003) on the diffuse rays.
     let mut mbvh_builds = Vec::new();
     let mut dacrt_setup = None;
-    let mut incoherent: Vec<(Method, TraceReport)> = Vec::new();
+    let mut incoherent: Vec<(String, TraceReport)> = Vec::new();
     if !a.incoherent.is_empty() {
         let mut mbvh = None;
         if a.incoherent.iter().any(|m| m.uses_mbvh()) {
@@ -204,21 +206,35 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         let dacrt = a.incoherent.iter().any(|m| m.uses_dacrt()).then(|| Dacrt::new(&scene));
         dacrt_setup = dacrt.as_ref().map(|d| d.setup_time().as_secs_f64());
         let workload = wb.build(RayKind::Diffuse);
-        for &method in &a.incoherent {
+        let runs = a.incoherent.iter().flat_map(|&m| {
+            let groups: Vec<Option<u64>> =
+                if m == Method::MbvhRs { a.rs_groups.iter().map(|&g| Some(g)).collect() } else { vec![None] };
+            groups.into_iter().map(move |g| (m, g))
+        });
+        for (method, group) in runs {
             for &t in &a.threads {
-                let mut tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
+                let options = TraceOptions { method, stream_group: group.map(|g| g as usize), ..Default::default() };
+                let mut tracer = Tracer::new(&tree, None, options);
                 if let Some(m) = &mbvh {
                     tracer = tracer.with_mbvh(m);
                 }
                 if let Some(d) = &dacrt {
                     tracer = tracer.with_dacrt(d);
                 }
-                let tile = if method.uses_dacrt() { DACRT_TILE } else { HARNESS_TILE };
+                let tile = match group {
+                    _ if method.uses_dacrt() => DACRT_TILE,
+                    Some(g) => tile_for_group(HARNESS_TILE, g as u32),
+                    None => HARNESS_TILE,
+                };
                 let (report, results) =
                     measure(&tracer, &workload, tile, t as usize, a.warmup as usize, a.reps as usize)?;
                 validate(&reference, &workload, &results, 256)
                     .map_err(|m| format!("validation failed ({method}): {m}"))?;
-                incoherent.push((method, report));
+                let label = match group {
+                    Some(g) => format!("{method} ({g})"),
+                    None => method.to_string(),
+                };
+                incoherent.push((label, report));
             }
         }
     }
@@ -324,8 +340,8 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         let _ = writeln!(
             md,
             "\nIncoherent rays: the MBVH methods and DACRT on the diffuse rays against Embree's single-ray and \
-             stream APIs (per ray: 4-box SIMD tests, node fetches, triangle tests; MBVH RS groups are 16x16 tiles, \
-             256 rays; DACRT traces {DACRT_TILE}x{DACRT_TILE} tiles as sets, and its box tests are ray-box filter \
+             stream APIs (per ray: 4-box SIMD tests, node fetches, triangle tests; MBVH RS rows name their ray-group \
+             size, groups cut along the Z-order curve of each tile; DACRT traces {DACRT_TILE}x{DACRT_TILE} tiles as sets, and its box tests are ray-box filter \
              tests, its fetches recursion nodes). MBVH builds (median of {}): {}. DACRT setup (copying the \
              triangles, its only preparation, not in the rates): {}.\n",
             a.builds,

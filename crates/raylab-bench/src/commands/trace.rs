@@ -8,10 +8,10 @@ use raylab_core::trace::Tracer;
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 use serde_json::json;
 
-use crate::args::{KdArgs, MethodArgs, SceneArgs, in_range};
+use crate::args::{KdArgs, MethodArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene, with_spinner};
-use crate::timing::{measure, validate};
+use crate::timing::{measure, tile_for_group, validate};
 
 /// Traces the Embree harness's rays and reports Mrays/s, checksums and counters.
 #[derive(Args, Debug)]
@@ -55,16 +55,6 @@ pub struct TraceArgs {
     json: bool,
 }
 
-/// Parses `--group`: a power of two in 2^4..=2^12.
-fn parse_group(s: &str) -> Result<u64, String> {
-    let g: u64 = s.parse().map_err(|_| format!("'{s}' is not a whole number"))?;
-    if g.is_power_of_two() && (16..=4096).contains(&g) {
-        Ok(g)
-    } else {
-        Err(format!("{g} is not a power of two from 16 to 4096"))
-    }
-}
-
 /// Runs the command.
 pub fn run(a: &TraceArgs) -> Result<(), String> {
     let env = Environment::detect();
@@ -84,10 +74,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
             return Err(format!("--group sets the ray group of --method mbvh-rs, not of {}", options.method));
         }
         options.stream_group = Some(g as usize);
-        // The smallest power-of-two tile that holds a whole group.
-        while tile * tile < g {
-            tile *= 2;
-        }
+        tile = tile_for_group(tile as u32, g as u32) as u64;
     }
     let mbvh = options.method.uses_mbvh().then(|| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string());

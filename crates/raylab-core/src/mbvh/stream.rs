@@ -102,16 +102,19 @@ impl Mbvh {
         stats: &mut TraversalStats,
     ) {
         let n = ids.len() as u32;
+        // Per lane, an active-ray stack: `lanes[k][..top[k]]` holds it. The storage only grows, so rays are
+        // written without a branch on whether they hit the lane's box (the write is kept by advancing `top`).
+        let mut top = [ids.len(), 0, 0, 0];
         let mut lanes: [Vec<u32>; 4] = [ids, Vec::new(), Vec::new(), Vec::new()];
         let mut tasks: Vec<Task> = vec![Task { child: 0, tris: 0, lane: 0, count: n }];
         let mut current: Vec<u32> = Vec::new();
         let (mut fetches, mut box_tests, mut leaves, mut tests) = (0u64, 0u64, 0u64, 0u64);
         let (mut leaf_rays, mut slots4, mut slots8, mut slots16) = (0u64, 0u64, 0u64, 0u64);
         while let Some(task) = tasks.pop() {
-            let stack = &mut lanes[task.lane as usize];
-            let start = stack.len() - task.count as usize;
+            let lane = task.lane as usize;
+            top[lane] -= task.count as usize;
             current.clear();
-            current.extend(stack.drain(start..));
+            current.extend_from_slice(&lanes[lane][top[lane]..top[lane] + task.count as usize]);
             if task.tris > 0 {
                 leaves += 1;
                 // Shadow rays blocked since they were queued leave the stream here.
@@ -129,8 +132,14 @@ impl Mbvh {
             }
             fetches += 1;
             let node = &self.nodes[task.child as usize];
-            let mut counts = [0u32; 4];
-            let mut lengths = [0f32; 4];
+            let start = top;
+            for (k, stack) in lanes.iter_mut().enumerate() {
+                if stack.len() < top[k] + current.len() {
+                    stack.resize(top[k] + current.len(), 0);
+                }
+            }
+            let mut lengths = V::splat(0.0);
+            let used = V::Mask::from_bits(node.used);
             for &id in &current {
                 let s = &slots[id as usize];
                 if s.blocked {
@@ -138,28 +147,35 @@ impl Mbvh {
                 }
                 box_tests += 1;
                 let (near, mask) = s.slab.test(node, s.ray.tmin, s.best);
-                let bits = mask.bits() & node.used;
-                if bits == 0 {
-                    continue;
-                }
-                let mut dist = [0f32; 4];
-                near.write_to(&mut dist);
-                for k in 0..4 {
-                    if bits >> k & 1 == 1 {
-                        lanes[k].push(id);
-                        counts[k] += 1;
-                        lengths[k] += dist[k];
-                    }
+                let hit = mask & used;
+                lengths = lengths + V::select(hit, near, V::splat(0.0));
+                let bits = hit.bits();
+                for (k, stack) in lanes.iter_mut().enumerate() {
+                    stack[top[k]] = id;
+                    top[k] += (bits >> k & 1) as usize;
                 }
             }
+            let mut lengths_out = [0f32; 4];
+            lengths.write_to(&mut lengths_out);
             // Children with the largest accumulated length first on the stack, so the shortest is walked first.
             let mut order = [0usize, 1, 2, 3];
             if ordered {
-                order.sort_unstable_by(|&a, &b| lengths[b].total_cmp(&lengths[a]));
+                // A stable sort by descending length as ranks: lane k goes after every lane that is longer,
+                // or as long and before it.
+                for k in 0..4 {
+                    let rank = (0..4)
+                        .filter(|&j| {
+                            let c = lengths_out[j].total_cmp(&lengths_out[k]);
+                            c.is_gt() || (c.is_eq() && j < k)
+                        })
+                        .count();
+                    order[rank] = k;
+                }
             }
             for k in order {
-                if counts[k] > 0 {
-                    tasks.push(Task { child: node.child[k], tris: node.count[k], lane: k as u8, count: counts[k] });
+                let count = (top[k] - start[k]) as u32;
+                if count > 0 {
+                    tasks.push(Task { child: node.child[k], tris: node.count[k], lane: k as u8, count });
                 }
             }
         }
