@@ -11,6 +11,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
+use super::partition::{Partitioned, block_partition};
 use super::records::RayRecord;
 use crate::aabb::Aabb;
 
@@ -91,25 +92,27 @@ fn gather<V: Vf32>(rs: [&RayRecord; 4], f: impl Fn(&RayRecord) -> f32) -> V {
     V::from_slice(&[f(rs[0]), f(rs[1]), f(rs[2]), f(rs[3])])
 }
 
-/// Moves the rays whose flags satisfy `front` to the front (two cursors, each ray moved at most once; the
-/// flags move with their rays) and returns how many there are.
+/// Moves the rays whose flags satisfy `front` to the front and returns how many there are; the flags move with
+/// their rays, and each ray moves at most once ([`block_partition`]).
 pub(super) fn partition(rays: &mut [RayRecord], flags: &mut [u8], front: impl Fn(u8) -> bool) -> usize {
-    let (mut i, mut j) = (0, rays.len());
-    loop {
-        while i < j && front(flags[i]) {
-            i += 1;
-        }
-        while i < j && !front(flags[j - 1]) {
-            j -= 1;
-        }
-        if i >= j {
-            return i;
-        }
-        rays.swap(i, j - 1);
-        flags.swap(i, j - 1);
-        i += 1;
-        j -= 1;
+    struct Flagged<'a, F> {
+        rays: &'a mut [RayRecord],
+        flags: &'a mut [u8],
+        front: F,
     }
+    impl<F: Fn(u8) -> bool> Partitioned for Flagged<'_, F> {
+        fn len(&self) -> usize {
+            self.rays.len()
+        }
+        fn is_front(&self, i: usize) -> bool {
+            (self.front)(self.flags[i])
+        }
+        fn swap(&mut self, a: usize, b: usize) {
+            self.rays.swap(a, b);
+            self.flags.swap(a, b);
+        }
+    }
+    block_partition(&mut Flagged { rays, flags, front })
 }
 
 /// Moves the rays of `rays` that enter `b` to the front and returns how many there are; `flags` is scratch.

@@ -9,6 +9,7 @@
 //! call: DACRT wants large ray sets (a whole G-buffer's reflection rays, or large tiles), not single rays.
 
 mod filter;
+mod partition;
 mod records;
 mod split;
 mod traverse;
