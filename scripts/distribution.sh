@@ -25,7 +25,7 @@ for scene in atrium kitchen arena forest; do
   part=$(mktemp)
   target/release/raylab-bench distribution --scene "$scene" --methods mbvh,mbvh-rs --width "$scene_size" \
     --height "$scene_size" --bounces 3 --threads 1 --speeds-only --markdown "$part"
-  { echo; echo "Command: \`$(sed -n 's/^Command: `\(.*\)`$/\1/p' "$part")\`"; sed -n '/^[a-z]*: [0-9]*x[0-9]*/,$p' "$part"; } >>"$table"
+  { echo; echo "Command: \`$(sed -n 's/^Command: `\(.*\)`$/\1/p' "$part")\`"; echo; sed -n '/^\*\*Figure 2\*\*/,$p' "$part"; } >>"$table"
   rm -f "$part"
 done
 

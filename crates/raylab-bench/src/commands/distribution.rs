@@ -62,7 +62,7 @@ pub struct DistributionArgs {
     /// Also write the markdown tables to this file.
     #[arg(long)]
     markdown: Option<PathBuf>,
-    /// Write only the speed table (Figures 2-3), headed by the scene, for comparing scenes.
+    /// Write only the speed table (Figure 2), titled with the scene, for comparing scenes.
     #[arg(long)]
     speeds_only: bool,
 }
@@ -127,7 +127,7 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
             first_image = Some(acc);
         }
     }
-    write_tables(&mut md, &runs, a.bounces as usize, a.speeds_only);
+    write_tables(&mut md, &runs, a.bounces as usize, a.speeds_only.then_some(scene_name.as_str()));
     print!("{md}");
     if let Some(p) = &a.markdown {
         std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
@@ -164,7 +164,7 @@ type Counter = (&'static str, fn(&TraversalStats) -> u64, bool);
 
 /// The paper's Figures 2-8 as tables: speeds per bounce, then the counters per bounce for closest-hit
 /// (reflection) and shadow rays apart, then the leaf SIMD use against the group size.
-fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: bool) {
+fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: Option<&str>) {
     let bounce_header = |md: &mut String, first: &str| {
         let _ = write!(md, "| {first} |");
         for b in 0..=bounces {
@@ -173,7 +173,11 @@ fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: bool
     };
     let rate = |rays: u64, s: f64| rays as f64 / s.max(1e-12) / 1e6;
 
-    let _ = writeln!(md, "**Figures 2-3**: Mrays/s per bounce (bounce 0: camera rays) and of the shadow rays.\n");
+    let title = match speeds_only {
+        Some(scene) => format!("**Figure 2**, {scene}"),
+        None => "**Figures 2-3**".to_string(),
+    };
+    let _ = writeln!(md, "{title}: Mrays/s per bounce (bounce 0: camera rays) and of the shadow rays.\n");
     bounce_header(md, "method | group");
     let _ = writeln!(md, " shadow | all rays |");
     let _ = writeln!(md, "|---|---:|{}", "---:|".repeat(bounces + 3));
@@ -193,7 +197,7 @@ fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: bool
         );
     }
 
-    if speeds_only {
+    if speeds_only.is_some() {
         return;
     }
     let counters: [Counter; 3] = [
