@@ -3,6 +3,7 @@
 //! With no subcommand it renders the default built-in scene to `raylab.png`.
 
 mod commands;
+mod isect_cost;
 mod timing;
 
 use raylab_bench::{args, env, prepare};

@@ -92,6 +92,7 @@ pub fn shade_reflections(
             let mut hits = vec![None; set.len()];
             tracer.intersect_tile(&set, set.len(), 1, &mut hits, &mut out.stats);
             out.stages.secondary += t0.elapsed().as_secs_f64();
+            out.stages.secondary_tests += out.stats.isect_tests;
             let layer = Layer { rays: &set, hits: &hits, dims: (set.len(), 1), seeds: &seeds };
             let colors = ctx.shade_layer(layer, 1, &mut out, &mut ShadowScratch::default());
             (colors, out)

@@ -270,8 +270,10 @@ impl TileContext<'_> {
         let (rw, rh) = if rows { (bw as usize, bh as usize) } else { (n, 1) };
         sc.hits.clear();
         sc.hits.resize(n, None);
+        let tests_before = out.stats.isect_tests;
         self.tracer.intersect_tile(&sc.rays, rw, rh, &mut sc.hits, &mut out.stats);
         out.stages.primary += t0.elapsed().as_secs_f64();
+        out.stages.primary_tests += out.stats.isect_tests - tests_before;
 
         let colors = match settings.view {
             FrameView::Normals | FrameView::Depth => Vec::new(),

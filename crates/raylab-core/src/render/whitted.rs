@@ -195,8 +195,10 @@ impl TileContext<'_> {
         }
         let t0 = Instant::now();
         let mut hits = vec![None; b.rays.len()];
+        let tests_before = out.stats.isect_tests;
         self.tracer.intersect_tile(&b.rays, dims.0, dims.1, &mut hits, &mut out.stats);
         out.stages.secondary += t0.elapsed().as_secs_f64();
+        out.stages.secondary_tests += out.stats.isect_tests - tests_before;
         let layer = Layer { rays: &b.rays, hits: &hits, dims, seeds: &b.seeds };
         let mut colors = self.shade_layer(layer, depth, out, sc);
         for ((c, h), a) in colors.iter_mut().zip(&hits).zip(&b.absorption) {
