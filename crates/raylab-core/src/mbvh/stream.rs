@@ -160,17 +160,16 @@ impl Mbvh {
             // Children with the largest accumulated length first on the stack, so the shortest is walked first.
             let mut order = [0usize, 1, 2, 3];
             if ordered {
-                // A stable sort by descending length as ranks: lane k goes after every lane that is longer,
-                // or as long and before it.
-                for k in 0..4 {
-                    let rank = (0..4)
-                        .filter(|&j| {
-                            let c = lengths_out[j].total_cmp(&lengths_out[k]);
-                            c.is_gt() || (c.is_eq() && j < k)
-                        })
-                        .count();
-                    order[rank] = k;
+                // Descending by length, ties in lane order: keys of (length bits, reversed lane) through a
+                // five-comparator sorting network (lengths are sums of non-negative distances, so their bits
+                // order like the values).
+                let mut keys: [u64; 4] =
+                    std::array::from_fn(|k| (u64::from(lengths_out[k].to_bits()) << 2) | (3 - k as u64));
+                for (a, b) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+                    let (hi, lo) = (keys[a].max(keys[b]), keys[a].min(keys[b]));
+                    (keys[a], keys[b]) = (hi, lo);
                 }
+                order = keys.map(|key| 3 - (key & 3) as usize);
             }
             for k in order {
                 let count = (top[k] - start[k]) as u32;
