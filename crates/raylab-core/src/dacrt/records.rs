@@ -3,7 +3,7 @@
 //! triangle reference carries its box (for partitioning and for the children's boxes) and the id of its full
 //! record, which only leaves fetch.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use crate::aabb::Aabb;
 use crate::ray::Ray;
@@ -59,12 +59,6 @@ impl TriRecord {
         Self { min: v[0].min(v[1]).min(v[2]), id, max: v[0].max(v[1]).max(v[2]), _pad: 0 }
     }
 
-    /// The box.
-    #[inline(always)]
-    pub fn bounds(&self) -> Aabb {
-        Aabb::new(self.min, self.max)
-    }
-
     /// Twice the box centre on `axis` (the partitions only compare centres, so the halving is skipped).
     #[inline(always)]
     pub fn centre2(&self, axis: usize) -> f32 {
@@ -84,18 +78,36 @@ pub(super) struct SetBounds {
 impl SetBounds {
     /// Bounds of `tris`.
     pub fn of(tris: &[TriRecord]) -> Self {
-        tris.iter().fold(SetBounds { bounds: Aabb::EMPTY, centres: Aabb::EMPTY }, |s, t| s.grow(t))
-    }
-
-    /// These bounds grown by one triangle.
-    #[inline(always)]
-    pub fn grow(self, t: &TriRecord) -> Self {
-        let b = t.bounds();
-        SetBounds { bounds: self.bounds.union(b), centres: self.centres.grow(b.min + b.max) }
+        tris.iter().fold(BoundsAcc::EMPTY, |a, t| a.grow(t)).bounds()
     }
 
     /// The union of two bounds.
     pub fn union(self, o: SetBounds) -> Self {
         SetBounds { bounds: self.bounds.union(o.bounds), centres: self.centres.union(o.centres) }
+    }
+}
+
+/// [`SetBounds`] being accumulated in SIMD lanes (w unused): box min and max, doubled-centre min and max.
+/// Division bins every triangle of a set, so this is DACRT's busiest loop on small ray sets.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BoundsAcc([Vec4; 4]);
+
+impl BoundsAcc {
+    /// Bounds of nothing.
+    pub const EMPTY: BoundsAcc = BoundsAcc([Vec4::INFINITY, Vec4::NEG_INFINITY, Vec4::INFINITY, Vec4::NEG_INFINITY]);
+
+    /// These bounds grown by one triangle.
+    #[inline(always)]
+    pub fn grow(self, t: &TriRecord) -> Self {
+        let (lo, hi) = (t.min.extend(0.0), t.max.extend(0.0));
+        let centre2 = lo + hi;
+        let [a, b, c, d] = self.0;
+        BoundsAcc([a.min(lo), b.max(hi), c.min(centre2), d.max(centre2)])
+    }
+
+    /// The accumulated bounds.
+    pub fn bounds(self) -> SetBounds {
+        let [a, b, c, d] = self.0;
+        SetBounds { bounds: Aabb::new(a.truncate(), b.truncate()), centres: Aabb::new(c.truncate(), d.truncate()) }
     }
 }

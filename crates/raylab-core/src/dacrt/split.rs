@@ -5,7 +5,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::records::{SetBounds, TriRecord};
+use crate::aabb::Aabb;
+
+use super::records::{BoundsAcc, SetBounds, TriRecord};
 
 /// How DACRT divides triangles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -100,13 +102,14 @@ fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
 /// are the unions of their bins. `None` when every triangle falls in one bin.
 fn sah_partition(tris: &mut [TriRecord], b: &SetBounds, axis: usize, lo: f32, width: f32) -> Option<Split> {
     let scale = BINS as f32 / width;
-    let mut bins = [EMPTY_SET; BINS];
+    let mut acc = [BoundsAcc::EMPTY; BINS];
     let mut counts = [0u32; BINS];
     for t in tris.iter() {
         let k = bin_of(t.centre2(axis), lo, scale);
-        bins[k] = bins[k].grow(t);
+        acc[k] = acc[k].grow(t);
         counts[k] += 1;
     }
+    let bins = acc.map(BoundsAcc::bounds);
     let mut right_area = [0.0f32; BINS];
     let mut acc = bins[BINS - 1];
     let mut right_n = [0u32; BINS];
@@ -141,7 +144,7 @@ fn sah_partition(tris: &mut [TriRecord], b: &SetBounds, axis: usize, lo: f32, wi
 }
 
 /// Bounds of no triangle.
-const EMPTY_SET: SetBounds = SetBounds { bounds: crate::aabb::Aabb::EMPTY, centres: crate::aabb::Aabb::EMPTY };
+const EMPTY_SET: SetBounds = SetBounds { bounds: Aabb::EMPTY, centres: Aabb::EMPTY };
 
 /// Moves the triangles for which `first` holds to the front (two cursors, each element moved at most once);
 /// returns how many there are.
