@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::aabb::Aabb;
 
+use super::partition::{Partitioned, block_partition};
 use super::records::{BoundsAcc, SetBounds, TriRecord};
 
 /// How DACRT divides triangles.
@@ -61,9 +62,10 @@ pub(super) struct Split {
     pub second: SetBounds,
 }
 
-/// Divides `tris` (whose bounds are `b`) in place into two non-empty halves. `None` when there are fewer than
-/// two triangles. Sets whose centres all coincide are cut in the middle of the list.
-pub(super) fn divide(tris: &mut [TriRecord], b: &SetBounds, rule: SplitRule) -> Option<Split> {
+/// Divides `tris` (whose bounds are `b`) in place into two non-empty halves; `scratch` holds each triangle's
+/// bin meanwhile. `None` when there are fewer than two triangles. Sets whose centres all coincide are cut in
+/// the middle of the list.
+pub(super) fn divide(tris: &mut [TriRecord], b: &SetBounds, rule: SplitRule, scratch: &mut Vec<u8>) -> Option<Split> {
     let n = tris.len();
     if n < 2 {
         return None;
@@ -80,7 +82,7 @@ pub(super) fn divide(tris: &mut [TriRecord], b: &SetBounds, rule: SplitRule) -> 
     let measurable = width > 0.0 && width.is_finite();
     if measurable
         && rule == SplitRule::Sah
-        && let Some(s) = sah_partition(tris, b, axis, lo, width)
+        && let Some(s) = sah_partition(tris, b, axis, lo, width, scratch)
     {
         return Some(s);
     }
@@ -100,14 +102,23 @@ fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
 
 /// Bins `tris` on `axis`, picks the cheapest boundary by the SAH and partitions at it; the halves' bounds
 /// are the unions of their bins. `None` when every triangle falls in one bin.
-fn sah_partition(tris: &mut [TriRecord], b: &SetBounds, axis: usize, lo: f32, width: f32) -> Option<Split> {
+fn sah_partition(
+    tris: &mut [TriRecord],
+    b: &SetBounds,
+    axis: usize,
+    lo: f32,
+    width: f32,
+    bin_of_tri: &mut Vec<u8>,
+) -> Option<Split> {
     let scale = BINS as f32 / width;
     let mut acc = [BoundsAcc::EMPTY; BINS];
     let mut counts = [0u32; BINS];
+    bin_of_tri.clear();
     for t in tris.iter() {
         let k = bin_of(t.centre2(axis), lo, scale);
         acc[k] = acc[k].grow(t);
         counts[k] += 1;
+        bin_of_tri.push(k as u8);
     }
     let bins = acc.map(BoundsAcc::bounds);
     let mut right_area = [0.0f32; BINS];
@@ -138,7 +149,7 @@ fn sah_partition(tris: &mut [TriRecord], b: &SetBounds, axis: usize, lo: f32, wi
         }
     }
     let (bin, _) = best?;
-    let mid = partition(tris, |t| bin_of(t.centre2(axis), lo, scale) <= bin);
+    let mid = partition(tris, bin_of_tri, bin as u8);
     let union = |r: std::ops::Range<usize>| bins[r].iter().fold(EMPTY_SET, |a, &b| a.union(b));
     Some(Split { mid, axis, first: union(0..bin + 1), second: union(bin + 1..BINS) })
 }
@@ -146,24 +157,28 @@ fn sah_partition(tris: &mut [TriRecord], b: &SetBounds, axis: usize, lo: f32, wi
 /// Bounds of no triangle.
 const EMPTY_SET: SetBounds = SetBounds { bounds: Aabb::EMPTY, centres: Aabb::EMPTY };
 
-/// Moves the triangles for which `first` holds to the front (two cursors, each element moved at most once);
-/// returns how many there are.
-fn partition(tris: &mut [TriRecord], first: impl Fn(&TriRecord) -> bool) -> usize {
-    let (mut i, mut j) = (0, tris.len());
-    loop {
-        while i < j && first(&tris[i]) {
-            i += 1;
-        }
-        while i < j && !first(&tris[j - 1]) {
-            j -= 1;
-        }
-        if i >= j {
-            return i;
-        }
-        tris.swap(i, j - 1);
-        i += 1;
-        j -= 1;
+/// Moves the triangles whose bin (in `bins`, which moves with them) is at most `last` to the front and
+/// returns how many there are ([`block_partition`]: which side a triangle goes to is read from a byte, so no
+/// branch depends on it).
+fn partition(tris: &mut [TriRecord], bins: &mut [u8], last: u8) -> usize {
+    struct Binned<'a> {
+        tris: &'a mut [TriRecord],
+        bins: &'a mut [u8],
+        last: u8,
     }
+    impl Partitioned for Binned<'_> {
+        fn len(&self) -> usize {
+            self.tris.len()
+        }
+        fn is_front(&self, i: usize) -> bool {
+            self.bins[i] <= self.last
+        }
+        fn swap(&mut self, a: usize, b: usize) {
+            self.tris.swap(a, b);
+            self.bins.swap(a, b);
+        }
+    }
+    block_partition(&mut Binned { tris, bins, last })
 }
 
 #[cfg(test)]
@@ -189,7 +204,7 @@ mod tests {
         for rule in SplitRule::ALL {
             let mut t = tris(&centres);
             let b = SetBounds::of(&t);
-            let s = divide(&mut t, &b, rule).unwrap();
+            let s = divide(&mut t, &b, rule, &mut Vec::new()).unwrap();
             assert!(s.mid > 0 && s.mid < t.len(), "{rule:?}");
             assert_eq!(s.axis, 0);
             let split = t[..s.mid].iter().map(|r| r.centre2(0)).fold(f32::MIN, f32::max);
@@ -201,7 +216,7 @@ mod tests {
             assert!(ids.iter().copied().eq(0..100), "a permutation");
         }
         let mut t = tris(&centres);
-        let s = divide(&mut t, &SetBounds::of(&tris(&centres)), SplitRule::Median).unwrap();
+        let s = divide(&mut t, &SetBounds::of(&tris(&centres)), SplitRule::Median, &mut Vec::new()).unwrap();
         assert_eq!(s.mid, 50);
     }
 
@@ -209,10 +224,10 @@ mod tests {
     fn coincident_centres_are_cut_in_the_middle_and_single_triangles_are_not_divided() {
         let mut t = tris(&[3.0; 9]);
         let b = SetBounds::of(&t);
-        let s = divide(&mut t, &b, SplitRule::Sah).unwrap();
+        let s = divide(&mut t, &b, SplitRule::Sah, &mut Vec::new()).unwrap();
         assert_eq!(s.mid, 4);
         let mut one = tris(&[1.0]);
-        assert!(divide(&mut one, &SetBounds::of(&tris(&[1.0])), SplitRule::Sah).is_none());
+        assert!(divide(&mut one, &SetBounds::of(&tris(&[1.0])), SplitRule::Sah, &mut Vec::new()).is_none());
     }
 
     #[test]

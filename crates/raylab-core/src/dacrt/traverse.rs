@@ -142,7 +142,7 @@ impl<A: Answer> Walk<'_, A> {
         self.stats.nodes += 1;
         let p = self.params;
         let small = tris.len() <= p.leaf_tris || rays.len() <= p.leaf_rays;
-        let split = if small || depth >= MAX_DEPTH { None } else { divide(tris, &b, p.split) };
+        let split = if small || depth >= MAX_DEPTH { None } else { divide(tris, &b, p.split, &mut self.flags) };
         let Some(s) = split else {
             self.stats.leaves += 1;
             self.stats.isect_tests += (rays.len() * tris.len()) as u64;
