@@ -248,9 +248,22 @@ fn animation_moves_objects_and_updates_the_structure_each_method_needs() {
 /// shows (its traced frame) holds the CPU Whitted renderer's first reflections, within 35 dB over the
 /// reflective pixels, with synchronous and asynchronous readback and with the animation on (the scene posed at
 /// the frame's time); interlacing traces a share of the rows; the composite is drawn.
+/// PSNR of the R-buffer screenshot at `path` (display values, gamma 2.2) against the CPU renderer's
+/// reflections `want` (linear, `None` where a pixel reflects nothing).
+fn rbuffer_psnr(path: &Path, want: &[Option<glam::Vec3>]) -> f64 {
+    let r = image::open(path).unwrap().to_rgba8();
+    assert_eq!(r.dimensions(), (W, H));
+    let to_lin = |v: u8| (v as f32 / 255.0).powf(2.2);
+    let pairs = r
+        .pixels()
+        .zip(want)
+        .filter_map(|(p, w)| w.map(|w| (glam::Vec3::new(to_lin(p.0[0]), to_lin(p.0[1]), to_lin(p.0[2])), w)));
+    raylab_core::render::hybrid::psnr(pairs).unwrap()
+}
+
 #[test]
 fn hybrid_mode_reflections_match_the_cpu_renderer() {
-    use raylab_core::render::hybrid::{psnr, reference_reflections};
+    use raylab_core::render::hybrid::reference_reflections;
     use raylab_core::trace::Tracer;
     let dir = tempfile::tempdir().unwrap();
     let args = SceneArgs::named("atrium");
@@ -279,14 +292,7 @@ fn hybrid_mode_reflections_match_the_cpu_renderer() {
         for k in ["raster_ms", "readback_ms", "trace_ms", "upload_ms", "composite_ms"] {
             assert!(h[k].as_f64().is_some_and(|v| v >= 0.0), "{name}: {k} in {h}");
         }
-        let r = image::open(&traced).unwrap().to_rgba8();
-        assert_eq!(r.dimensions(), (W, H));
-        let to_lin = |v: u8| (v as f32 / 255.0).powf(2.2);
-        let pairs = r
-            .pixels()
-            .zip(&want)
-            .filter_map(|(p, w)| w.map(|w| (glam::Vec3::new(to_lin(p.0[0]), to_lin(p.0[1]), to_lin(p.0[2])), w)));
-        let db = psnr(pairs).unwrap();
+        let db = rbuffer_psnr(&traced, &want);
         assert!(db >= 35.0, "{name}: R-buffer {db:.1} dB from the CPU renderer's reflections");
         assert!(shot.pixels().filter(|p| p.0[0] > 40).count() > (W * H / 8) as usize, "{name}: composite drawn");
     }
@@ -305,13 +311,7 @@ fn hybrid_mode_reflections_match_the_cpu_renderer() {
     let tree = raylab_core::kdtree::KdTree::build(&moved, &KdParams::default()).unwrap();
     let tracer = Tracer::new(&tree, None, TraceOptions::default());
     let want = reference_reflections(&moved, &tracer, &camera, light, &settings);
-    let r = image::open(&traced).unwrap().to_rgba8();
-    let to_lin = |v: u8| (v as f32 / 255.0).powf(2.2);
-    let pairs = r
-        .pixels()
-        .zip(&want)
-        .filter_map(|(p, w)| w.map(|w| (glam::Vec3::new(to_lin(p.0[0]), to_lin(p.0[1]), to_lin(p.0[2])), w)));
-    let db = psnr(pairs).unwrap();
+    let db = rbuffer_psnr(&traced, &want);
     assert!(db >= 35.0, "animated: R-buffer {db:.1} dB from the CPU renderer's reflections at t = {t}");
 
     // Interlacing: half the rows a frame.

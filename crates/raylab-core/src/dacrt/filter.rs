@@ -11,7 +11,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::partition::{Partitioned, block_partition};
+use super::partition::partition;
 use super::records::RayRecord;
 use crate::aabb::Aabb;
 
@@ -92,33 +92,11 @@ fn gather<V: Vf32>(rs: [&RayRecord; 4], f: impl Fn(&RayRecord) -> f32) -> V {
     V::from_slice(&[f(rs[0]), f(rs[1]), f(rs[2]), f(rs[3])])
 }
 
-/// Moves the rays whose flags satisfy `front` to the front and returns how many there are; the flags move with
-/// their rays, and each ray moves at most once ([`block_partition`]).
-pub(super) fn partition(rays: &mut [RayRecord], flags: &mut [u8], front: impl Fn(u8) -> bool) -> usize {
-    struct Flagged<'a, F> {
-        rays: &'a mut [RayRecord],
-        flags: &'a mut [u8],
-        front: F,
-    }
-    impl<F: Fn(u8) -> bool> Partitioned for Flagged<'_, F> {
-        fn len(&self) -> usize {
-            self.rays.len()
-        }
-        fn is_front(&self, i: usize) -> bool {
-            (self.front)(self.flags[i])
-        }
-        fn swap(&mut self, a: usize, b: usize) {
-            self.rays.swap(a, b);
-            self.flags.swap(a, b);
-        }
-    }
-    block_partition(&mut Flagged { rays, flags, front })
-}
-
 /// Moves the rays of `rays` that enter `b` to the front and returns how many there are; `flags` is scratch.
 pub(super) fn filter<V: Vf32>(rays: &mut [RayRecord], b: &FilterBox, flags: &mut Vec<u8>) -> usize {
     classify::<V, 1>(rays, &[*b], flags);
-    partition(rays, flags, |f| f != 0)
+    let n = rays.len();
+    partition(rays, &mut flags[..n], |f| f != 0)
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::aabb::Aabb;
 
-use super::partition::{Partitioned, block_partition};
+use super::partition::partition;
 use super::records::{BoundsAcc, SetBounds, TriRecord};
 
 /// How DACRT divides triangles.
@@ -149,37 +149,13 @@ fn sah_partition(
         }
     }
     let (bin, _) = best?;
-    let mid = partition(tris, bin_of_tri, bin as u8);
+    let mid = partition(tris, bin_of_tri, |k| k as usize <= bin);
     let union = |r: std::ops::Range<usize>| bins[r].iter().fold(EMPTY_SET, |a, &b| a.union(b));
     Some(Split { mid, axis, first: union(0..bin + 1), second: union(bin + 1..BINS) })
 }
 
 /// Bounds of no triangle.
 const EMPTY_SET: SetBounds = SetBounds { bounds: Aabb::EMPTY, centres: Aabb::EMPTY };
-
-/// Moves the triangles whose bin (in `bins`, which moves with them) is at most `last` to the front and
-/// returns how many there are ([`block_partition`]: which side a triangle goes to is read from a byte, so no
-/// branch depends on it).
-fn partition(tris: &mut [TriRecord], bins: &mut [u8], last: u8) -> usize {
-    struct Binned<'a> {
-        tris: &'a mut [TriRecord],
-        bins: &'a mut [u8],
-        last: u8,
-    }
-    impl Partitioned for Binned<'_> {
-        fn len(&self) -> usize {
-            self.tris.len()
-        }
-        fn is_front(&self, i: usize) -> bool {
-            self.bins[i] <= self.last
-        }
-        fn swap(&mut self, a: usize, b: usize) {
-            self.tris.swap(a, b);
-            self.bins.swap(a, b);
-        }
-    }
-    block_partition(&mut Binned { tris, bins, last })
-}
 
 #[cfg(test)]
 mod tests {

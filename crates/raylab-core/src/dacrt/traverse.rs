@@ -6,7 +6,8 @@
 use raylab_simd::{VMask, Vf32};
 
 use super::DacrtParams;
-use super::filter::{FilterBox, classify, partition};
+use super::filter::{FilterBox, classify};
+use super::partition::partition;
 use super::records::{RayRecord, SetBounds, TriRecord};
 use super::split::divide;
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};

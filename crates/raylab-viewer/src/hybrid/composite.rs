@@ -6,7 +6,7 @@ use raylab_core::render::shade::{AMBIENT, DIRECT};
 use raylab_core::scene::{MaterialKind, PointLight, Scene};
 
 use super::gbuffer::{TARGET_FORMAT, Targets};
-use crate::compositor::FRAME_FORMAT;
+use crate::compositor::{FRAME_FORMAT, fullscreen_pipeline};
 use crate::gpu::Gpu;
 
 /// Materials the composite pass knows (later ones are drawn with the last).
@@ -62,36 +62,7 @@ impl CompositePass {
                 uniform(4, (MATERIALS * MATERIAL_BYTES) as u64),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("composite"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("composite"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: FRAME_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = fullscreen_pipeline(device, "composite", &shader, &layout, FRAME_FORMAT);
         let buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
