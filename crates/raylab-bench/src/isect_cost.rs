@@ -3,10 +3,10 @@
 //!
 //! A frame's kernels interleave node steps and triangle tests too finely to time apart (a clock read per leaf
 //! would cost more than the tests). Instead the renderer counts the tests of each trace stage, and this module
-//! times the same kernel on the same kind of work alone: 2x2 packets of the view's primary rays, each tested
-//! against the triangles of the kd-tree leaves its rays end in (the leaves a traversal tests last, holding both
-//! the hit and its neighbours' misses). The caches are warm here, so the intersection share it gives is a lower
-//! bound.
+//! times the same kernel on the same kind of work alone: packets (2x2, or 4x2 with eight lanes) of the view's
+//! primary rays, each tested against the triangles of the kd-tree leaves its rays end in (the leaves a
+//! traversal tests last, holding both the hit and its neighbours' misses). The caches are warm here, so the
+//! intersection share it gives is a lower bound.
 
 use std::hint::black_box;
 use std::ops::Range;
@@ -18,16 +18,18 @@ use raylab_core::packet::{PacketHits, RayPacket, intersect_packet};
 use raylab_core::ray::Ray;
 use raylab_core::scene::Camera;
 use raylab_core::stats::TraversalStats;
-use raylab_simd::Vf32;
+use raylab_simd::{Backend, Kernel, Vf32};
 
-/// Seconds one packet-triangle test takes on `tree`'s triangles, seen through `camera` at `width x height`
-/// (`None` when no packet's rays hit anything).
-pub fn seconds_per_packet_test(tree: &KdTree, camera: &Camera, width: u32, height: u32) -> Option<f64> {
-    #[cfg(target_arch = "x86_64")]
-    if raylab_simd::Backend::detect() == raylab_simd::Backend::Sse {
-        return measure::<raylab_simd::sse::F32x4>(tree, camera, width, height);
-    }
-    measure::<raylab_simd::scalar::F32x4>(tree, camera, width, height)
+/// Seconds one packet-triangle test with `backend`'s packets takes on `tree`'s triangles, seen through
+/// `camera` at `width x height` (`None` when no packet's rays hit anything).
+pub fn seconds_per_packet_test(
+    tree: &KdTree,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    backend: Backend,
+) -> Option<f64> {
+    raylab_simd::dispatch(backend, Measure { tree, camera, width, height })
 }
 
 /// Pixels between sampled packets, each way.
@@ -35,13 +37,30 @@ const STRIDE: u32 = 8;
 /// Least time spent timing.
 const MIN_TIME: Duration = Duration::from_millis(50);
 
+/// The timing run as a [`Kernel`], so it uses the packets of the backend being measured.
+struct Measure<'a> {
+    tree: &'a KdTree,
+    camera: &'a Camera,
+    width: u32,
+    height: u32,
+}
+
+impl Kernel for Measure<'_> {
+    type Output = Option<f64>;
+    #[inline(always)]
+    fn run<V: Vf32>(self) -> Option<f64> {
+        measure::<V>(self.tree, self.camera, self.width, self.height)
+    }
+}
+
+#[inline(always)]
 fn measure<V: Vf32>(tree: &KdTree, camera: &Camera, width: u32, height: u32) -> Option<f64> {
     let raster = camera.raster(width, height);
+    let pw = V::LANES as u32 / 2;
     let mut work: Vec<(RayPacket<V>, Vec<u32>)> = Vec::new();
     for y in (0..height.saturating_sub(1)).step_by(STRIDE as usize) {
-        for x in (0..width.saturating_sub(1)).step_by(STRIDE as usize) {
-            let rays: Vec<Ray> =
-                [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(dx, dy)| raster.primary(x + dx, y + dy)).to_vec();
+        for x in (0..width.saturating_sub(pw - 1)).step_by(STRIDE as usize) {
+            let rays: Vec<Ray> = (0..V::LANES as u32).map(|i| raster.primary(x + i % pw, y + i / pw)).collect();
             let mut tris: Vec<u32> = rays
                 .iter()
                 .filter_map(|r| tree.intersect(r, &mut TraversalStats::default()).map(|h| leaves_at_hit(tree, r, h.t)))
@@ -51,7 +70,7 @@ fn measure<V: Vf32>(tree: &KdTree, camera: &Camera, width: u32, height: u32) -> 
             tris.sort_unstable();
             tris.dedup();
             if !tris.is_empty() {
-                let lanes: Vec<Option<Ray>> = rays.into_iter().map(Some).take(V::LANES).collect();
+                let lanes: Vec<Option<Ray>> = rays.into_iter().map(Some).collect();
                 work.push((RayPacket::new(&lanes), tris));
             }
         }
@@ -106,8 +125,10 @@ mod tests {
         let scene = builtin::build("arena", Detail::Test).unwrap();
         let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
         let camera = scene.views[0].camera;
-        let s = seconds_per_packet_test(&tree, &camera, 64, 48).expect("the view sees the arena");
-        assert!(s > 1e-10 && s < 1e-5, "{s}");
+        for backend in Backend::available() {
+            let s = seconds_per_packet_test(&tree, &camera, 64, 48, backend).expect("the view sees the arena");
+            assert!(s > 1e-10 && s < 1e-5, "{backend:?}: {s}");
+        }
         let raster = camera.raster(64, 48);
         let (mut hits, mut held) = (0, 0);
         for y in 0..48 {

@@ -19,7 +19,7 @@ pub enum Method {
     /// One ray at a time through the kd-tree (thesis Listing 2.2).
     #[default]
     Mono,
-    /// Omni-directional 2x2 ray packets (thesis 4.1.2, Listing 4.1).
+    /// Omni-directional ray packets, 2x2 (4x2 with AVX2) (thesis 4.1.2, Listing 4.1).
     Packet,
     /// One frustum per tile with interval traversal and packet/leaf culling (Listing 4.2, 4.1.3-4.1.4).
     Frustum,
@@ -72,7 +72,7 @@ impl Method {
         }
     }
 
-    /// True for the methods that trace tiles as 2x2 packets (and so need rows of pixels).
+    /// True for the methods that trace tiles as packets (and so need rows of pixels).
     pub fn uses_packets(self) -> bool {
         matches!(self, Method::Packet | Method::Frustum | Method::Mft | Method::Cone | Method::MftCone)
     }

@@ -3,7 +3,8 @@
 //! Kernels are written once, generic over [`Vf32`], and instantiated with a hardware backend and with the
 //! portable [`scalar::F32x4`], which has the same API and the same per-lane semantics (including how `min`,
 //! `max` and comparisons treat NaN), so tests can run every kernel both ways and compare. Backends are
-//! chosen once, when a tracer is set up ([`Backend::detect`]), never per ray.
+//! chosen once, when a tracer is set up ([`Backend::detect`], which checks the CPU at run time), never per
+//! ray; a kernel runs with a backend's lane type through [`dispatch`] or [`dispatch4`].
 //!
 //! This is the only raylab crate that may use `unsafe`; each block says why it is sound.
 
@@ -13,6 +14,7 @@ use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Not, Sub};
 pub mod scalar;
 #[cfg(target_arch = "x86_64")]
 pub mod sse;
+pub mod x8;
 
 /// A lane mask produced by comparisons.
 pub trait VMask:
@@ -100,24 +102,44 @@ pub trait Vf32:
 pub enum Backend {
     /// Portable scalar lanes (any CPU; also the twin the tests compare against).
     Scalar,
-    /// SSE2 on x86-64 (always present there).
+    /// SSE2 on x86-64 (always present there): four lanes.
     Sse,
+    /// AVX2 and FMA on x86-64 CPUs that have them (checked at run time): eight lanes for the kernels that
+    /// take any width (packets of 4x2 rays); kernels of four-wide structures (MBVH nodes, DACRT's ray
+    /// filter) use SSE with it.
+    Avx2,
 }
 
 impl Backend {
     /// The fastest backend this CPU supports.
     pub fn detect() -> Self {
-        if cfg!(target_arch = "x86_64") { Backend::Sse } else { Backend::Scalar }
+        Self::available()[0]
     }
 
     /// Every backend this CPU can run, fastest first.
     pub fn available() -> Vec<Backend> {
         let mut v = Vec::new();
-        if cfg!(target_arch = "x86_64") {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if avx2_detected() {
+                v.push(Backend::Avx2);
+            }
             v.push(Backend::Sse);
         }
         v.push(Backend::Scalar);
         v
+    }
+
+    /// Lanes of [`dispatch`]'s vectors with this backend on this CPU.
+    pub fn lanes(self) -> usize {
+        struct Lanes;
+        impl Kernel for Lanes {
+            type Output = usize;
+            fn run<V: Vf32>(self) -> usize {
+                V::LANES
+            }
+        }
+        dispatch(self, Lanes)
     }
 
     /// The name shown in reports.
@@ -125,43 +147,119 @@ impl Backend {
         match self {
             Backend::Scalar => "scalar",
             Backend::Sse => "sse2",
+            Backend::Avx2 => "avx2",
         }
     }
+}
+
+/// A computation written once for any lane type: [`dispatch`] runs it with the type a [`Backend`] picks.
+///
+/// Generic functions a kernel calls should be `#[inline(always)]`, so that under [`Backend::Avx2`] they are
+/// compiled into the AVX2 entry point with it; one compiled on its own is still correct but runs the eight
+/// lanes as pairs of SSE instructions.
+pub trait Kernel {
+    /// What the kernel returns.
+    type Output;
+    /// Runs the kernel with lane type `V`.
+    fn run<V: Vf32>(self) -> Self::Output;
+}
+
+/// Runs `k` with the widest vectors `backend` offers on this CPU: eight lanes for [`Backend::Avx2`] (when the
+/// CPU lacks AVX2, SSE instead), four otherwise.
+pub fn dispatch<K: Kernel>(backend: Backend, k: K) -> K::Output {
+    match backend {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the guard checked that the CPU has AVX2 and FMA, every feature `run_avx2` is compiled for.
+        Backend::Avx2 if avx2_detected() => unsafe { run_avx2(k) },
+        #[cfg(target_arch = "x86_64")]
+        Backend::Sse | Backend::Avx2 => k.run::<sse::F32x4>(),
+        _ => k.run::<scalar::F32x4>(),
+    }
+}
+
+/// True when this CPU has AVX2 and FMA ([`Backend::Avx2`]).
+#[cfg(target_arch = "x86_64")]
+fn avx2_detected() -> bool {
+    is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
+}
+
+/// Runs `k` with eight lanes, compiled for AVX2 and FMA: the kernel's inlined code, including
+/// [`x8::F32x8`]'s per-lane operations, becomes 256-bit instructions.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn run_avx2<K: Kernel>(k: K) -> K::Output {
+    k.run::<x8::F32x8>()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn check<V: Vf32>() {
-        let a = V::from_slice(&[1.0, -2.0, f32::NAN, 0.0][..V::LANES]);
-        let b = V::from_slice(&[0.5, 3.0, 1.0, -0.0][..V::LANES]);
-        assert_eq!(a.lt(b).bits(), 0b0010);
-        assert_eq!(a.le(b).bits(), 0b1010, "0.0 <= -0.0");
-        assert_eq!(a.eq(b).bits(), 0b1000);
-        let mn = a.min(b);
-        assert_eq!([mn.lane(0), mn.lane(1), mn.lane(2)], [0.5, -2.0, 1.0], "NaN in a keeps b");
-        let mx = b.max(a);
-        assert!(mx.lane(2).is_nan(), "NaN in the second operand is returned");
-        assert_eq!(V::select(V::Mask::from_bits(0b0101), a, b).lane(1), 3.0);
-        assert_eq!(a.abs().lane(1), 2.0);
-        assert_eq!(a.reduce_min(), -2.0);
-        assert_eq!(a.reduce_max(), 1.0);
-        let mut out = [0.0; 4];
-        (a + b).write_to(&mut out[..V::LANES]);
-        assert_eq!(out[0], 1.5);
-        assert!(!V::Mask::from_bits(0).any() && V::Mask::from_bits(0).none());
-        assert_eq!((!V::Mask::from_bits(0b0001)).bits(), 0b1110);
+    /// The lane semantics every backend must share, on lanes 0..4 and (where there are eight) 4..8.
+    struct Semantics;
+
+    impl Kernel for Semantics {
+        type Output = ();
+        fn run<V: Vf32>(self) {
+            let a4 = [1.0, -2.0, f32::NAN, 0.0];
+            let b4 = [0.5, 3.0, 1.0, -0.0];
+            let (mut a, mut b) = ([0.0f32; 8], [0.0f32; 8]);
+            for i in 0..8 {
+                a[i] = a4[i % 4];
+                b[i] = b4[i % 4];
+            }
+            let n = V::LANES;
+            let (a, b) = (V::from_slice(&a[..n]), V::from_slice(&b[..n]));
+            let rep = |bits4: u32| if n == 8 { bits4 | bits4 << 4 } else { bits4 };
+            assert_eq!(a.lt(b).bits(), rep(0b0010));
+            assert_eq!(a.le(b).bits(), rep(0b1010), "0.0 <= -0.0");
+            assert_eq!(a.eq(b).bits(), rep(0b1000));
+            let mn = a.min(b);
+            for base in (0..n).step_by(4) {
+                assert_eq!([mn.lane(base), mn.lane(base + 1), mn.lane(base + 2)], [0.5, -2.0, 1.0], "NaN in a keeps b");
+            }
+            let mx = b.max(a);
+            assert!(mx.lane(2).is_nan() && mx.lane(n - 2).is_nan(), "NaN in the second operand is returned");
+            let sel = V::select(V::Mask::from_bits(rep(0b0101)), a, b);
+            assert_eq!([sel.lane(0), sel.lane(1), sel.lane(n - 3)], [1.0, 3.0, 3.0]);
+            assert_eq!(a.abs().lane(n - 3), 2.0);
+            assert_eq!(a.reduce_min(), -2.0);
+            assert_eq!(a.reduce_max(), 1.0);
+            let mut out = [0.0; 8];
+            (a + b).write_to(&mut out[..n]);
+            assert_eq!([out[0], out[n - 4]], [1.5, 1.5]);
+            assert!((a * b - a / b).lane(1) == -6.0 + 2.0 / 3.0);
+            assert!(!V::Mask::from_bits(0).any() && V::Mask::from_bits(0).none());
+            let all = (1u32 << n) - 1;
+            assert_eq!((!V::Mask::from_bits(0b0001)).bits(), all & !1);
+            assert_eq!(V::Mask::from_bits(u32::MAX).bits(), all);
+            assert_eq!((V::Mask::from_bits(0b0110) ^ V::Mask::from_bits(0b0011)).bits(), 0b0101);
+            assert_eq!(V::splat(2.5).lane(n - 1), 2.5);
+        }
     }
 
     #[test]
-    fn scalar_semantics() {
-        check::<scalar::F32x4>();
+    fn every_backend_has_the_same_lane_semantics() {
+        for b in Backend::available() {
+            dispatch(b, Semantics);
+        }
+        // The eight-lane type outside the AVX2 entry point (compiled for the baseline).
+        Semantics.run::<x8::F32x8>();
     }
 
-    #[cfg(target_arch = "x86_64")]
     #[test]
-    fn sse_semantics() {
-        check::<sse::F32x4>();
+    fn backends_are_listed_fastest_first_and_scalar_always() {
+        let avail = Backend::available();
+        assert_eq!(Backend::detect(), avail[0]);
+        assert_eq!(avail.last(), Some(&Backend::Scalar));
+        assert_eq!(Backend::Scalar.lanes(), 4);
+        #[cfg(target_arch = "x86_64")]
+        {
+            assert!(avail.contains(&Backend::Sse));
+            assert_eq!(Backend::Sse.lanes(), 4);
+            let eight = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
+            assert_eq!(avail.contains(&Backend::Avx2), eight);
+            assert_eq!(Backend::Avx2.lanes(), if eight { 8 } else { 4 }, "without AVX2 the backend falls back");
+        }
     }
 }

@@ -151,7 +151,7 @@ impl ShadingRun<'_> {
             "\n**Table 3.1**: share of the frame per stage, hard shadows, reflections and refractions to depth {} \
              (thread-summed times). Traversal and intersection run interleaved inside one kernel call: each trace \
              stage's triangle tests are counted and charged the cost of one test measured alone on the same \
-             scene (the view's 2x2 primary packets against the triangles of the leaves they end in, warm \
+             scene (the view's primary packets against the triangles of the leaves they end in, warm \
              caches: a lower bound on intersection), and the rest of the stage is traversal.\n",
             RenderSettings::DEFAULT_DEPTH
         );
@@ -164,8 +164,8 @@ impl ShadingRun<'_> {
         for s in subjects {
             let tracer = Self::tracer(s);
             let c = self.timed(s, &tracer, s.light, Shadows::Hard, RenderSettings::DEFAULT_DEPTH);
-            let per_test =
-                crate::isect_cost::seconds_per_packet_test(s.tree, &s.camera, self.size.0, self.size.1).unwrap_or(0.0);
+            let (w, h, backend) = (self.size.0, self.size.1, tracer.options.backend);
+            let per_test = crate::isect_cost::seconds_per_packet_test(s.tree, &s.camera, w, h, backend).unwrap_or(0.0);
             let split = c.stages.split(per_test);
             let total: f64 = split.iter().sum();
             let _ = write!(md, "| {} | {:.1} | {:.1} |", s.name, c.fps, per_test * 1e9);

@@ -151,7 +151,7 @@ impl Dacrt {
             };
             match self.backend {
                 #[cfg(target_arch = "x86_64")]
-                Backend::Sse => self.start::<raylab_simd::sse::F32x4, A>(&mut walk, &mut scratch),
+                Backend::Sse | Backend::Avx2 => self.start::<raylab_simd::sse::F32x4, A>(&mut walk, &mut scratch),
                 _ => self.start::<raylab_simd::scalar::F32x4, A>(&mut walk, &mut scratch),
             }
             scratch.flags = walk.flags;

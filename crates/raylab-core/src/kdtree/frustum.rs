@@ -50,6 +50,7 @@ pub(super) struct Leaf<'a> {
 
 /// Tests `leaf` against packets `set` of `tile`, culling packets whose rays miss its box when `cull` is on.
 /// Returns true when some lane's closest hit changed.
+#[inline(always)]
 pub(super) fn leaf_intersect<V: Vf32>(
     leaf: &Leaf,
     tile: &mut PacketTile<V>,
@@ -92,6 +93,7 @@ pub(super) fn leaf_intersect<V: Vf32>(
 }
 
 /// Any-hit counterpart of [`leaf_intersect`]: marks lanes blocked by the leaf's triangles in `blocked`.
+#[inline(always)]
 pub(super) fn leaf_occlude<V: Vf32>(
     leaf: &Leaf,
     tile: &PacketTile<V>,
@@ -131,6 +133,7 @@ pub(super) fn leaf_occlude<V: Vf32>(
 }
 
 /// The largest current hit distance over the lanes of packets `set` (infinite while any lane has none).
+#[inline(always)]
 pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> f32 {
     set.iter().fold(0.0f32, |m, &j| m.max(tile.farthest_hit[j]))
 }
@@ -138,6 +141,7 @@ pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> f32 {
 impl KdTree {
     /// Closest hits of the packets `set` of `tile`, whose rays share the origin of bundle `f` (a pyramid
     /// frustum or a cone) and lie inside it; results accumulate in `tile.hits`.
+    #[inline(always)]
     pub fn intersect_frustum<B: Bundle, V: Vf32>(
         &self,
         f: &B,
@@ -157,6 +161,7 @@ impl KdTree {
 
     /// Marks in `blocked` the lanes of packets `set` that something blocks. The frustum `f` must bound the
     /// rays' segments (it may be built from the other end of the segments, e.g. from a light).
+    #[inline(always)]
     pub fn occluded_frustum<B: Bundle, V: Vf32>(
         &self,
         f: &B,
@@ -175,6 +180,7 @@ impl KdTree {
 
     /// Walks the leaves the frustum overlaps, roughly front to back. `leaf(leaf, stats)` returns the distance
     /// beyond which no ray needs more leaves, and whether the walk can stop.
+    #[inline(always)]
     fn traverse_frustum<B: Bundle>(
         &self,
         f: &B,

@@ -13,7 +13,7 @@ use super::frustum::{Leaf, front_and_back, hit_limit, leaf_intersect, leaf_occlu
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::Aabb;
-use crate::packet::{Bundle4, Frustum, PacketTile};
+use crate::packet::{Bundle4, Frustum, MAX_LANES, PacketTile};
 use crate::stats::TraversalStats;
 
 /// Four frustums with a common origin, one per SIMD lane.
@@ -33,12 +33,19 @@ pub struct Frustum4<V: Vf32> {
 
 impl<V: Vf32> Frustum4<V> {
     /// Packs up to four frustums with the same origin; `None` entries leave a lane empty.
+    #[inline(always)]
     pub fn new(f: [Option<Frustum>; 4]) -> Option<Self> {
-        assert_eq!(V::LANES, 4, "MFT traces four frustums");
+        assert!(V::LANES >= 4, "MFT traces four frustums");
         let first = f.iter().flatten().next()?;
         let origin = first.origin;
         assert!(f.iter().flatten().all(|x| x.origin == origin), "MFT frustums share their origin");
-        let lanes = |g: &dyn Fn(&Frustum) -> f32, empty: f32| V::from_slice(&f.map(|x| x.as_ref().map_or(empty, g)));
+        let lanes = |g: &dyn Fn(&Frustum) -> f32, empty: f32| {
+            let mut a = [empty; MAX_LANES];
+            for (lane, x) in a.iter_mut().zip(&f) {
+                *lane = x.as_ref().map_or(empty, g);
+            }
+            V::from_slice(&a[..V::LANES])
+        };
         let axes =
             |g: &dyn Fn(&Frustum, usize) -> f32, empty: f32| [0, 1, 2].map(|k| lanes(&|x: &Frustum| g(x, k), empty));
         let valid = f.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
@@ -57,12 +64,15 @@ impl<V: Vf32> Frustum4<V> {
 }
 
 impl<V: Vf32> Bundle4<V> for Frustum4<V> {
+    #[inline(always)]
     fn origin(&self) -> glam::Vec3 {
         self.origin
     }
+    #[inline(always)]
     fn t_range(&self) -> (V, V) {
         (self.t_min, self.t_max)
     }
+    #[inline(always)]
     fn valid(&self) -> V::Mask {
         self.valid
     }
@@ -80,6 +90,64 @@ impl<V: Vf32> Bundle4<V> for Frustum4<V> {
     }
 }
 
+/// What an MFT walk does at a leaf (a trait rather than a closure, so that it is always inlined into the
+/// walk: see [`raylab_simd::Kernel`]).
+trait MftLeaf<V: Vf32> {
+    /// Tests `leaf` for the frustum lanes in `active` (bits), whose intervals start at `near`; returns each
+    /// lane's distance limit and the lanes that are finished.
+    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32);
+}
+
+/// Closest hits: `limit[i]` is the farthest current hit of frustum `i`'s packets.
+struct ClosestLeaves<'a, V: Vf32> {
+    tile: &'a mut PacketTile<V>,
+    sets: &'a [Vec<usize>; 4],
+    cull: bool,
+    limit: [f32; MAX_LANES],
+}
+
+impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32) {
+        for (i, set) in self.sets.iter().enumerate() {
+            let leaf = Leaf { near: near[i], ids: leaf.ids.clone(), ..*leaf };
+            if active >> i & 1 == 1 && leaf_intersect(&leaf, self.tile, set, self.cull, stats) {
+                self.limit[i] = hit_limit(self.tile, set);
+            }
+        }
+        (V::from_slice(&self.limit[..V::LANES]), 0)
+    }
+}
+
+/// Occlusion: a frustum is finished once all its packets' lanes are blocked.
+struct BlockedLeaves<'a, V: Vf32> {
+    tile: &'a PacketTile<V>,
+    sets: &'a [Vec<usize>; 4],
+    cull: bool,
+    blocked: &'a mut [V::Mask],
+    done: u32,
+}
+
+impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32) {
+        for (i, set) in self.sets.iter().enumerate() {
+            if active >> i & 1 == 1 {
+                let leaf = Leaf { near: near[i], ids: leaf.ids.clone(), ..*leaf };
+                leaf_occlude(&leaf, self.tile, set, self.cull, self.blocked, stats);
+                let mut open = 0;
+                for &j in set {
+                    open |= (self.tile.packets[j].valid & !self.blocked[j]).bits();
+                }
+                if open == 0 {
+                    self.done |= 1 << i;
+                }
+            }
+        }
+        (V::splat(f32::INFINITY), self.done)
+    }
+}
+
 #[derive(Clone, Copy)]
 struct Entry<V: Vf32> {
     node: u32,
@@ -93,6 +161,7 @@ const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 
 impl KdTree {
     /// Closest hits of the packets of `tile`; `sets[i]` lists the packets that frustum lane `i` bounds.
+    #[inline(always)]
     pub fn intersect_mft<V: Vf32, F: Bundle4<V>>(
         &self,
         f: &F,
@@ -101,20 +170,12 @@ impl KdTree {
         cull: bool,
         stats: &mut TraversalStats,
     ) {
-        let mut limit = [f32::INFINITY; 4];
-        self.traverse_mft(f, stats, |tree, ids, bounds, near, active, stats| {
-            for (i, set) in sets.iter().enumerate() {
-                let leaf = Leaf { tree, ids: ids.clone(), bounds, near: near[i] };
-                if active >> i & 1 == 1 && leaf_intersect(&leaf, tile, set, cull, stats) {
-                    limit[i] = hit_limit(tile, set);
-                }
-            }
-            (V::from_slice(&limit), 0)
-        });
+        self.traverse_mft(f, stats, &mut ClosestLeaves { tile, sets, cull, limit: [f32::INFINITY; MAX_LANES] });
     }
 
     /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` lists the packets
     /// that frustum lane `i` bounds.
+    #[inline(always)]
     pub fn occluded_mft<V: Vf32, F: Bundle4<V>>(
         &self,
         f: &F,
@@ -124,29 +185,12 @@ impl KdTree {
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
-        let mut done = 0u32;
-        self.traverse_mft(f, stats, |tree, ids, bounds, near, active, stats| {
-            for (i, set) in sets.iter().enumerate() {
-                if active >> i & 1 == 1 {
-                    let leaf = Leaf { tree, ids: ids.clone(), bounds, near: near[i] };
-                    leaf_occlude(&leaf, tile, set, cull, blocked, stats);
-                    if set.iter().all(|&j| (tile.packets[j].valid & !blocked[j]).none()) {
-                        done |= 1 << i;
-                    }
-                }
-            }
-            (V::splat(f32::INFINITY), done)
-        });
+        self.traverse_mft(f, stats, &mut BlockedLeaves { tile, sets, cull, blocked, done: 0 });
     }
 
-    /// Walks the leaves the four frustums overlap. `leaf(tree, ids, box, near_per_lane, active_bits, stats)`
-    /// returns each lane's distance limit and the lanes that are finished.
-    fn traverse_mft<V: Vf32, F: Bundle4<V>>(
-        &self,
-        f: &F,
-        stats: &mut TraversalStats,
-        mut leaf: impl FnMut(&KdTree, std::ops::Range<usize>, Aabb, [f32; 4], u32, &mut TraversalStats) -> (V, u32),
-    ) {
+    /// Walks the leaves the four frustums overlap, handing each to `leaf`.
+    #[inline(always)]
+    fn traverse_mft<V: Vf32, F: Bundle4<V>>(&self, f: &F, stats: &mut TraversalStats, leaf: &mut impl MftLeaf<V>) {
         if self.triangles().is_empty() || f.valid().none() {
             return;
         }
@@ -188,9 +232,11 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let mut near_lanes = [0.0f32; 4];
-            near.write_to(&mut near_lanes);
-            let (limit, finished) = leaf(self, n.leaf_range(), bounds, near_lanes, (active & !done).bits(), stats);
+            let mut near_lanes = [0.0f32; MAX_LANES];
+            near.write_to(&mut near_lanes[..V::LANES]);
+            let near4 = std::array::from_fn(|i| near_lanes[i]);
+            let leaf_at = Leaf { tree: self, ids: n.leaf_range(), bounds, near: 0.0 };
+            let (limit, finished) = leaf.visit(&leaf_at, near4, (active & !done).bits(), stats);
             done = done | V::Mask::from_bits(finished);
             if (f.valid() & !done).none() {
                 break;

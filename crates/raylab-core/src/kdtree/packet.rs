@@ -40,6 +40,7 @@ fn nonempty<V: Vf32>(t_near: V, t_far: V) -> V::Mask {
 impl KdTree {
     /// Closest hits of a packet's rays, written to `hits` (whose `t` may start below the rays' `tmax` to
     /// search only closer hits). Counts nodes, leaves and tests; the caller counts rays and packets.
+    #[inline(always)]
     pub fn intersect_packet<V: Vf32>(&self, p: &RayPacket<V>, hits: &mut PacketHits<V>, stats: &mut TraversalStats) {
         let mut tests = 0u64;
         self.traverse_packet(p, stats, |ids, active| {
@@ -53,6 +54,7 @@ impl KdTree {
     }
 
     /// The lanes whose rays are blocked within `(tmin, tmax]`.
+    #[inline(always)]
     pub fn occluded_packet<V: Vf32>(&self, p: &RayPacket<V>, stats: &mut TraversalStats) -> V::Mask {
         let mut blocked = V::Mask::from_bits(0);
         let mut tests = 0u64;

@@ -73,7 +73,9 @@ impl Mbvh {
     pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
         match self.backend {
             #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse => self.intersect_with::<raylab_simd::sse::F32x4>(ray, stats),
+            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
+                self.intersect_with::<raylab_simd::sse::F32x4>(ray, stats)
+            }
             _ => self.intersect_with::<raylab_simd::scalar::F32x4>(ray, stats),
         }
     }
@@ -82,7 +84,9 @@ impl Mbvh {
     pub fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
         match self.backend {
             #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse => self.occluded_with::<raylab_simd::sse::F32x4>(ray, stats),
+            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
+                self.occluded_with::<raylab_simd::sse::F32x4>(ray, stats)
+            }
             _ => self.occluded_with::<raylab_simd::scalar::F32x4>(ray, stats),
         }
     }
@@ -119,7 +123,9 @@ impl Mbvh {
     pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         match self.backend {
             #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse => self.occluder_with::<raylab_simd::sse::F32x4>(ray, stats),
+            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
+                self.occluder_with::<raylab_simd::sse::F32x4>(ray, stats)
+            }
             _ => self.occluder_with::<raylab_simd::scalar::F32x4>(ray, stats),
         }
     }

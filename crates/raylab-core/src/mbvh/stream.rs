@@ -46,7 +46,7 @@ impl Mbvh {
     ) {
         match self.backend {
             #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse => {
+            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
                 self.stream::<raylab_simd::sse::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit)
             }
             _ => self.stream::<raylab_simd::scalar::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit),
@@ -57,7 +57,7 @@ impl Mbvh {
     pub fn occluded_stream(&self, rays: &[Option<Ray>], out: &mut [bool], ordered: bool, stats: &mut TraversalStats) {
         match self.backend {
             #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse => {
+            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
                 self.stream::<raylab_simd::sse::F32x4>(rays, true, ordered, stats, |i, s| out[i] = s.blocked)
             }
             _ => self.stream::<raylab_simd::scalar::F32x4>(rays, true, ordered, stats, |i, s| out[i] = s.blocked),

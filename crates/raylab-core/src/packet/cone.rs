@@ -15,7 +15,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{RayPacket, tile::Bundle, tile::Bundle4};
+use super::{MAX_LANES, RayPacket, tile::Bundle, tile::Bundle4};
 
 /// A cone bounding a bundle of rays from one origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,6 +77,7 @@ impl Cone {
     }
 
     /// The cone of the valid rays of `packets[set]`, which all start at `origin`.
+    #[inline(always)]
     pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>], set: &[usize]) -> Option<Self> {
         let segs = set.iter().flat_map(|&j| {
             let p = &packets[j];
@@ -92,10 +93,12 @@ impl Cone {
 }
 
 impl Bundle for Cone {
+    #[inline(always)]
     fn origin(&self) -> Vec3 {
         self.origin
     }
 
+    #[inline(always)]
     fn t_range(&self) -> (f32, f32) {
         (self.t_min, self.t_max)
     }
@@ -130,11 +133,18 @@ pub struct Cone4<V: Vf32> {
 
 impl<V: Vf32> Cone4<V> {
     /// Packs up to four cones with the same apex; `None` entries leave a lane empty.
+    #[inline(always)]
     pub fn new(c: [Option<Cone>; 4]) -> Option<Self> {
-        assert_eq!(V::LANES, 4, "MFT traces four cones");
+        assert!(V::LANES >= 4, "MFT traces four cones");
         let origin = c.iter().flatten().next()?.origin;
         assert!(c.iter().flatten().all(|x| x.origin == origin), "MFT cones share their apex");
-        let lanes = |g: &dyn Fn(&Cone) -> f32, empty: f32| V::from_slice(&c.map(|x| x.as_ref().map_or(empty, g)));
+        let lanes = |g: &dyn Fn(&Cone) -> f32, empty: f32| {
+            let mut a = [empty; MAX_LANES];
+            for (lane, x) in a.iter_mut().zip(&c) {
+                *lane = x.as_ref().map_or(empty, g);
+            }
+            V::from_slice(&a[..V::LANES])
+        };
         let valid = c.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
         Some(Self {
             origin,
@@ -149,12 +159,15 @@ impl<V: Vf32> Cone4<V> {
 }
 
 impl<V: Vf32> Bundle4<V> for Cone4<V> {
+    #[inline(always)]
     fn origin(&self) -> Vec3 {
         self.origin
     }
+    #[inline(always)]
     fn t_range(&self) -> (V, V) {
         (self.t_min, self.t_max)
     }
+    #[inline(always)]
     fn valid(&self) -> V::Mask {
         self.valid
     }

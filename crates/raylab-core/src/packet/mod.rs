@@ -46,6 +46,7 @@ pub struct RayPacket<V: Vf32> {
 impl<V: Vf32> RayPacket<V> {
     /// Packs `rays` (at most `V::LANES`; `None` leaves a lane empty). Invalid rays (NaN, zero direction) leave
     /// their lane empty too.
+    #[inline(always)]
     pub fn new(rays: &[Option<Ray>]) -> Self {
         assert!(rays.len() <= V::LANES && V::LANES <= MAX_LANES);
         // Gather the raw fields; empty lanes get a harmless ray along +z.
@@ -64,8 +65,10 @@ impl<V: Vf32> RayPacket<V> {
                 field[i] = v;
             }
         }
-        let v = |k: usize| V::from_slice(&f[k][..V::LANES]);
-        let dir = [v(3), v(4), v(5)];
+        let [ox, oy, oz] = [load(&f[0]), load(&f[1]), load(&f[2])];
+        let [dx, dy, dz] = [load(&f[3]), load(&f[4]), load(&f[5])];
+        let (tmin, tmax) = (load(&f[6]), load(&f[7]));
+        let dir = [dx, dy, dz];
         let one = V::splat(1.0);
         let inv = [one / dir[0], one / dir[1], one / dir[2]];
         let inf = V::splat(f32::INFINITY);
@@ -74,7 +77,7 @@ impl<V: Vf32> RayPacket<V> {
         // The watertight test's per-ray constants, computed per lane with the scalar test's exact operations
         // (`RayShear::new`): kz is the axis of the largest |d| (ties to the lower axis), kx and ky follow it
         // cyclically and swap when d[kz] is negative.
-        let [ax, ay, az] = dir.map(|d| d.abs());
+        let (ax, ay, az) = (dx.abs(), dy.abs(), dz.abs());
         let kz0 = ax.ge(ay) & ax.ge(az);
         let kz1 = !kz0 & ay.ge(az);
         let kz2 = !(kz0 | kz1);
@@ -85,10 +88,9 @@ impl<V: Vf32> RayPacket<V> {
         let kx1 = (kz0 & pos) | (kz2 & neg);
         let ky0 = (kz1 & pos) | (kz2 & neg);
         let ky1 = (kz2 & pos) | (kz0 & neg);
-        let pick = |is0: V::Mask, is1: V::Mask| V::select(is0, dir[0], V::select(is1, dir[1], dir[2]));
         let sz = one / d_kz;
-        let sx = pick(kx0, kx1) * sz;
-        let sy = pick(ky0, ky1) * sz;
+        let sx = V::select(kx0, dx, V::select(kx1, dy, dz)) * sz;
+        let sy = V::select(ky0, dx, V::select(ky1, dy, dz)) * sz;
         let valid_mask = V::Mask::from_bits(valid);
         let axis_of = |is0: V::Mask, is1: V::Mask| {
             let (b0, b1, v) = ((is0 & valid_mask).bits(), (is1 & valid_mask).bits(), valid_mask.bits());
@@ -107,12 +109,12 @@ impl<V: Vf32> RayPacket<V> {
             _ => None,
         };
         Self {
-            org: [v(0), v(1), v(2)],
+            org: [ox, oy, oz],
             dir,
             inv,
             finite_inv,
-            tmin: v(6),
-            tmax: v(7),
+            tmin,
+            tmax,
             valid: V::Mask::from_bits(valid),
             axis_is: [[kx0, kx1], [ky0, ky1], [kz0, kz1]],
             shear: [sx, sy, sz],
@@ -121,10 +123,17 @@ impl<V: Vf32> RayPacket<V> {
     }
 
     /// The ray in lane `i`.
+    #[inline(always)]
     pub fn ray(&self, i: usize) -> Ray {
         let c = |v: &[V; 3]| Vec3::new(v[0].lane(i), v[1].lane(i), v[2].lane(i));
         Ray::segment(c(&self.org), c(&self.dir), self.tmin.lane(i), self.tmax.lane(i))
     }
+}
+
+/// The first `V::LANES` values of `field` as a vector.
+#[inline(always)]
+fn load<V: Vf32>(field: &[f32; MAX_LANES]) -> V {
+    V::from_slice(&field[..V::LANES])
 }
 
 /// Closest hits of a packet, per lane.
@@ -144,11 +153,13 @@ pub struct PacketHits<V: Vf32> {
 
 impl<V: Vf32> PacketHits<V> {
     /// No hits yet: `t` starts at each ray's `tmax`.
+    #[inline(always)]
     pub fn new(p: &RayPacket<V>) -> Self {
         Self { t: p.tmax, u: V::splat(0.0), v: V::splat(0.0), tri: [u32::MAX; MAX_LANES], hit: V::Mask::from_bits(0) }
     }
 
     /// The hits of all lanes at once (cheaper than [`PacketHits::get`] per lane).
+    #[inline(always)]
     pub fn to_hits(&self) -> [Option<Hit>; MAX_LANES] {
         let (mut t, mut u, mut v) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
         self.t.write_to(&mut t[..V::LANES]);
@@ -159,6 +170,7 @@ impl<V: Vf32> PacketHits<V> {
     }
 
     /// The hit of lane `i`.
+    #[inline(always)]
     pub fn get(&self, i: usize) -> Option<Hit> {
         (self.hit.bits() >> i & 1 == 1).then(|| Hit {
             t: self.t.lane(i),

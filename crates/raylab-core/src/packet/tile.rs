@@ -1,4 +1,5 @@
-//! A tile of rays cut into 2x2 packets, the unit that frustum kernels trace and cull (thesis 4.1.3-4.1.5).
+//! A tile of rays cut into 2x2 packets (4x2 with eight lanes), the unit that frustum kernels trace and cull
+//! (thesis 4.1.3-4.1.5).
 
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
@@ -7,8 +8,8 @@ use super::{PacketHits, RayPacket};
 use crate::aabb::Aabb;
 use crate::ray::Ray;
 
-/// The packets of a `width x height` tile in row-major pixel order, each 2 pixels wide and `V::LANES / 2`
-/// high; lane `i` holds pixel `(2 bx + i % 2, h by + i / 2)`. Pixels outside the tile leave lanes empty.
+/// The packets of a `width x height` tile in row-major pixel order, each `w = V::LANES / 2` pixels wide and
+/// 2 high; lane `i` holds pixel `(w bx + i % w, 2 by + i / w)`. Pixels outside the tile leave lanes empty.
 pub struct PacketTile<V: Vf32> {
     /// The packets.
     pub packets: Vec<RayPacket<V>>,
@@ -30,24 +31,27 @@ pub struct PacketTile<V: Vf32> {
 }
 
 impl<V: Vf32> PacketTile<V> {
+    /// Packet width in pixels.
+    pub const PACKET_W: usize = V::LANES / 2;
     /// Packet height in pixels.
-    pub const PACKET_H: usize = V::LANES / 2;
+    pub const PACKET_H: usize = 2;
 
     /// Cuts `rays` (row-major, `width x height`) into packets.
+    #[inline(always)]
     pub fn new(rays: &[Option<Ray>], width: usize, height: usize) -> Self {
-        let ph = Self::PACKET_H;
-        let (cols, rows) = (width.div_ceil(2), height.div_ceil(ph));
+        let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
+        let (cols, rows) = (width.div_ceil(pw), height.div_ceil(ph));
         let mut packets = Vec::with_capacity(cols * rows);
         let mut origin_pixel = Vec::with_capacity(cols * rows);
         let mut lane_rays = [None; super::MAX_LANES];
         for by in 0..rows {
             for bx in 0..cols {
                 for (i, slot) in lane_rays.iter_mut().enumerate().take(V::LANES) {
-                    let (x, y) = (2 * bx + i % 2, ph * by + i / 2);
+                    let (x, y) = (pw * bx + i % pw, ph * by + i / pw);
                     *slot = if x < width && y < height { rays[y * width + x] } else { None };
                 }
                 packets.push(RayPacket::new(&lane_rays[..V::LANES]));
-                origin_pixel.push((2 * bx, ph * by));
+                origin_pixel.push((pw * bx, ph * by));
             }
         }
         let hits: Vec<PacketHits<V>> = packets.iter().map(PacketHits::new).collect();
@@ -57,20 +61,23 @@ impl<V: Vf32> PacketTile<V> {
     }
 
     /// Calls `f(pixel_index, lane)` for every lane of packet `j` that holds a ray.
+    #[inline(always)]
     pub fn for_each_lane(&self, j: usize, mut f: impl FnMut(usize, usize)) {
         let (x0, y0) = self.origin_pixel[j];
         let bits = self.packets[j].valid.bits();
+        let pw = Self::PACKET_W;
         for i in (0..V::LANES).filter(|i| bits >> i & 1 == 1) {
-            f((y0 + i / 2) * self.width + x0 + i % 2, i);
+            f((y0 + i / pw) * self.width + x0 + i % pw, i);
         }
     }
 
     /// Indices of the packets inside the pixel rectangle `[x0, x1) x [y0, y1)` (packet-aligned).
+    #[inline(always)]
     pub fn packets_in(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> Vec<usize> {
-        let ph = Self::PACKET_H;
+        let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
         let mut v = Vec::new();
         for by in y0 / ph..y1.div_ceil(ph).min(self.rows) {
-            for bx in x0 / 2..x1.div_ceil(2).min(self.cols) {
+            for bx in x0 / pw..x1.div_ceil(pw).min(self.cols) {
                 v.push(by * self.cols + bx);
             }
         }
@@ -234,6 +241,7 @@ impl Frustum {
 
     /// The frustum of the valid rays of `packets[set]`, which must all start at `origin`, from the packets'
     /// inverse directions (no division per ray).
+    #[inline(always)]
     pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>], set: &[usize]) -> Option<Self> {
         let inf = V::splat(f32::INFINITY);
         let ninf = V::splat(f32::NEG_INFINITY);

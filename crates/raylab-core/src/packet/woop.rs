@@ -16,6 +16,20 @@ fn pick<V: Vf32>(is: [V::Mask; 2], x: V, y: V, z: V) -> V {
     V::select(is[0], x, V::select(is[1], y, z))
 }
 
+/// Corner `v` relative to the packet's origins, components in `(kx, ky, kz)` order for every lane.
+#[inline(always)]
+fn rel_uniform<V: Vf32>(p: &RayPacket<V>, v: Vec3, [kx, ky, kz]: [usize; 3]) -> (V, V, V) {
+    (V::splat(v[kx]) - p.org[kx], V::splat(v[ky]) - p.org[ky], V::splat(v[kz]) - p.org[kz])
+}
+
+/// Corner `v` relative to the packet's origins, permuted per lane into that lane's `(kx, ky, kz)` order.
+#[inline(always)]
+fn rel_permuted<V: Vf32>(p: &RayPacket<V>, v: Vec3) -> (V, V, V) {
+    let q = [V::splat(v.x) - p.org[0], V::splat(v.y) - p.org[1], V::splat(v.z) - p.org[2]];
+    let [kx, ky, kz] = p.axis_is;
+    (pick::<V>(kx, q[0], q[1], q[2]), pick::<V>(ky, q[0], q[1], q[2]), pick::<V>(kz, q[0], q[1], q[2]))
+}
+
 /// Result of testing one triangle: lanes hit and their distances and barycentrics.
 struct LaneHits<V: Vf32> {
     mask: V::Mask,
@@ -30,18 +44,8 @@ fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) ->
     // the permutation, by per-lane selects otherwise. Both give each lane exactly `v[k] - o[k]`.
     let [sx, sy, sz] = p.shear;
     let ((a_x, a_y, a_z), (b_x, b_y, b_z), (c_x, c_y, c_z)) = match p.uniform_axes {
-        Some([kx, ky, kz]) => {
-            let rel = |v: Vec3| (V::splat(v[kx]) - p.org[kx], V::splat(v[ky]) - p.org[ky], V::splat(v[kz]) - p.org[kz]);
-            (rel(tri[0]), rel(tri[1]), rel(tri[2]))
-        }
-        None => {
-            let rel = |v: Vec3| [V::splat(v.x) - p.org[0], V::splat(v.y) - p.org[1], V::splat(v.z) - p.org[2]];
-            let [kx, ky, kz] = p.axis_is;
-            let permute = |q: [V; 3]| {
-                (pick::<V>(kx, q[0], q[1], q[2]), pick::<V>(ky, q[0], q[1], q[2]), pick::<V>(kz, q[0], q[1], q[2]))
-            };
-            (permute(rel(tri[0])), permute(rel(tri[1])), permute(rel(tri[2])))
-        }
+        Some(k) => (rel_uniform(p, tri[0], k), rel_uniform(p, tri[1], k), rel_uniform(p, tri[2], k)),
+        None => (rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])),
     };
     let ax = a_x - sx * a_z;
     let ay = a_y - sy * a_z;

@@ -22,12 +22,11 @@ use glam::Vec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::method::Method;
 use crate::ray::{Hit, Ray};
 use crate::scene::{Camera, CameraRaster, PointLight, Scene};
 use crate::shadow::Shadows;
 use crate::stats::TraversalStats;
-use crate::trace::Tracer;
+use crate::trace::{TraceOptions, Tracer};
 use shade::to_display;
 
 /// Options of one rendered frame.
@@ -172,14 +171,15 @@ fn depth_color(t: f32, near: f32, far: f32) -> [u8; 4] {
     depth_grey(if far > near { (t - near) / (far - near) } else { 0.0 })
 }
 
-/// Edge of the blocks a method traces as one unit: a ray, a 2x2 packet, or the whole tile for frustums.
-fn unit_size(method: Method, tile: u32) -> u32 {
-    if method.uses_tiles() {
-        tile
-    } else if method.uses_packets() {
-        2
+/// Width and height of the blocks a method traces as one unit: a ray, a packet (2x2, or 4x2 with eight
+/// lanes), or the whole tile for frustums.
+fn unit_size(options: &TraceOptions, tile: u32) -> (u32, u32) {
+    if options.method.uses_tiles() {
+        (tile, tile)
+    } else if options.method.uses_packets() {
+        (options.backend.lanes() as u32 / 2, 2)
     } else {
-        1
+        (1, 1)
     }
 }
 
@@ -193,7 +193,7 @@ struct TileContext<'a> {
     width: u32,
     epsilon: f32,
     order: RayOrder,
-    /// Tile edge (the method's, see [`Method::tile_edge`]).
+    /// Tile edge (the method's, see [`crate::method::Method::tile_edge`]).
     tile: u32,
     /// The pixel offsets of a whole tile in `order`, computed once per frame.
     offsets: Vec<(u32, u32)>,
@@ -227,12 +227,12 @@ impl TileContext<'_> {
             self.block((x0, y0), (tw, th), offsets, self.order == RayOrder::Scanline, &mut out, &mut scratch);
             return out;
         }
-        let unit = unit_size(self.tracer.options.method, self.tile);
-        for uy in (0..th).step_by(unit as usize) {
-            for ux in (0..tw).step_by(unit as usize) {
+        let (uw, uh) = unit_size(&self.tracer.options, self.tile);
+        for uy in (0..th).step_by(uh as usize) {
+            for ux in (0..tw).step_by(uw as usize) {
                 let start = out.pixels.len();
                 let before = out.stats;
-                let (bw, bh) = (unit.min(tw - ux), unit.min(th - uy));
+                let (bw, bh) = (uw.min(tw - ux), uh.min(th - uy));
                 let rows = (0..bh).flat_map(|dy| (0..bw).map(move |dx| (dx, dy)));
                 self.block((x0 + ux, y0 + uy), (bw, bh), rows, true, &mut out, &mut scratch);
                 let work = if view == FrameView::Nodes {

@@ -14,7 +14,7 @@ pub enum FrameView {
     #[default]
     Shaded,
     /// Heat map of kd-tree nodes visited per pixel, primary and shadow rays together. A unit traced as one
-    /// (a ray, a 2x2 packet, a frustum's tile) shares its count evenly among its pixels.
+    /// (a ray, a packet, a frustum's tile) shares its count evenly among its pixels.
     Nodes,
     /// Heat map of ray/triangle intersection tests per pixel, shared like [`FrameView::Nodes`].
     Isects,

@@ -6,7 +6,7 @@
 //! light as in the thesis); otherwise they fall back to packets, which is always exact.
 
 use glam::Vec3;
-use raylab_simd::{Backend, VMask, Vf32};
+use raylab_simd::{Backend, Kernel, VMask, Vf32};
 use serde::Serialize;
 
 use crate::dacrt::{Dacrt, DacrtParams};
@@ -204,11 +204,10 @@ impl<'a> Tracer<'a> {
                 self.mbvh().intersect_stream(r, o, self.options.stream_order, stats)
             }),
             Method::Dacrt => self.dacrt().intersect(&self.options.dacrt, rays, out, stats),
-            _ => match self.options.backend {
-                #[cfg(target_arch = "x86_64")]
-                Backend::Sse => self.intersect_simd::<raylab_simd::sse::F32x4>(rays, width, height, out, stats),
-                _ => self.intersect_simd::<raylab_simd::scalar::F32x4>(rays, width, height, out, stats),
-            },
+            _ => raylab_simd::dispatch(
+                self.options.backend,
+                IntersectSimd { tracer: self, rays, width, height, out, stats },
+            ),
         }
     }
 
@@ -245,11 +244,10 @@ impl<'a> Tracer<'a> {
                 self.mbvh().occluded_stream(r, o, self.options.stream_order, stats)
             }),
             Method::Dacrt => self.dacrt().occluded(&self.options.dacrt, rays, out, stats),
-            _ => match self.options.backend {
-                #[cfg(target_arch = "x86_64")]
-                Backend::Sse => self.occluded_simd::<raylab_simd::sse::F32x4>(rays, width, height, toward, out, stats),
-                _ => self.occluded_simd::<raylab_simd::scalar::F32x4>(rays, width, height, toward, out, stats),
-            },
+            _ => raylab_simd::dispatch(
+                self.options.backend,
+                OccludedSimd { tracer: self, rays, width, height, toward, out, stats },
+            ),
         }
     }
 
@@ -285,6 +283,7 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    #[inline(always)]
     fn intersect_simd<V: Vf32>(
         &self,
         rays: &[Option<Ray>],
@@ -297,30 +296,43 @@ impl<'a> Tracer<'a> {
         let all: Vec<usize> = (0..tile.packets.len()).collect();
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
-        match self.options.method {
-            Method::Frustum => match common_origin_frustum(&tile, &all) {
-                Some(f) => self.tree.intersect_frustum(&f, &mut tile, &all, self.options.cull, stats),
-                None => self.packets_intersect(&mut tile, stats),
-            },
-            Method::Mft => match self.quadrants(&tile, rays, None, common_origin_frustum, toward_frustum) {
-                Some((b, sets, _)) => match Frustum4::new(b) {
-                    Some(f4) => self.tree.intersect_mft(&f4, &mut tile, &sets, self.options.cull, stats),
-                    None => self.packets_intersect(&mut tile, stats),
-                },
-                None => self.packets_intersect(&mut tile, stats),
-            },
-            Method::Cone => match common_origin_cone(&tile, &all) {
-                Some(c) => self.tree.intersect_frustum(&c, &mut tile, &all, self.options.cull, stats),
-                None => self.packets_intersect(&mut tile, stats),
-            },
-            Method::MftCone => match self.quadrants(&tile, rays, None, common_origin_cone, toward_cone) {
-                Some((b, sets, _)) => match Cone4::new(b) {
-                    Some(c4) => self.tree.intersect_mft(&c4, &mut tile, &sets, self.options.cull, stats),
-                    None => self.packets_intersect(&mut tile, stats),
-                },
-                None => self.packets_intersect(&mut tile, stats),
-            },
-            _ => self.packets_intersect(&mut tile, stats),
+        // Tiles no bundle covers are traced as packets (after the match, so the packet kernel is inlined once).
+        let cull = self.options.cull;
+        let bundled = match self.options.method {
+            Method::Frustum => {
+                let f = common_origin_frustum(&tile, &all);
+                if let Some(f) = &f {
+                    self.tree.intersect_frustum(f, &mut tile, &all, cull, stats);
+                }
+                f.is_some()
+            }
+            Method::Cone => {
+                let c = common_origin_cone(&tile, &all);
+                if let Some(c) = &c {
+                    self.tree.intersect_frustum(c, &mut tile, &all, cull, stats);
+                }
+                c.is_some()
+            }
+            Method::Mft => {
+                let quads = self.quadrants(&tile, rays, None, common_origin_frustum, toward_frustum);
+                let f4 = quads.and_then(|(b, sets, _)| Some((Frustum4::new(b)?, sets)));
+                if let Some((f4, sets)) = &f4 {
+                    self.tree.intersect_mft(f4, &mut tile, sets, cull, stats);
+                }
+                f4.is_some()
+            }
+            Method::MftCone => {
+                let quads = self.quadrants(&tile, rays, None, common_origin_cone, toward_cone);
+                let c4 = quads.and_then(|(b, sets, _)| Some((Cone4::new(b)?, sets)));
+                if let Some((c4, sets)) = &c4 {
+                    self.tree.intersect_mft(c4, &mut tile, sets, cull, stats);
+                }
+                c4.is_some()
+            }
+            _ => false,
+        };
+        if !bundled {
+            self.packets_intersect(&mut tile, stats);
         }
         for (j, hits) in tile.hits.iter().enumerate() {
             let lanes = hits.to_hits();
@@ -328,12 +340,14 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    #[inline(always)]
     fn packets_intersect<V: Vf32>(&self, tile: &mut PacketTile<V>, stats: &mut TraversalStats) {
         for (p, h) in tile.packets.iter().zip(tile.hits.iter_mut()) {
             self.tree.intersect_packet(p, h, stats);
         }
     }
 
+    #[inline(always)]
     fn occluded_simd<V: Vf32>(
         &self,
         rays: &[Option<Ray>],
@@ -396,6 +410,7 @@ impl<'a> Tracer<'a> {
 
     /// The four quadrant bundles of a tile (in whole packets) and the packets each bounds; `common` builds a
     /// bundle from packets with one origin, `toward` one from segments that end at a light.
+    #[inline(always)]
     fn quadrants<V: Vf32, B: Copy>(
         &self,
         tile: &PacketTile<V>,
@@ -404,8 +419,8 @@ impl<'a> Tracer<'a> {
         common: fn(&PacketTile<V>, &[usize]) -> Option<B>,
         toward_fn: fn(&[Option<Ray>], Vec3, f32) -> Option<B>,
     ) -> Option<Quadrants<B>> {
-        let ph = PacketTile::<V>::PACKET_H;
-        let (cx, cy) = (tile.cols.div_ceil(2) * 2, tile.rows.div_ceil(2) * ph);
+        let (pw, ph) = (PacketTile::<V>::PACKET_W, PacketTile::<V>::PACKET_H);
+        let (cx, cy) = (tile.cols.div_ceil(2) * pw, tile.rows.div_ceil(2) * ph);
         let (w, h) = (tile.width, tile.height);
         let quads = [(0, 0, cx.min(w), cy.min(h)), (cx, 0, w, cy.min(h)), (0, cy, cx.min(w), h), (cx, cy, w, h)];
         let mut sets: [Vec<usize>; 4] = Default::default();
@@ -447,7 +462,45 @@ impl<'a> Tracer<'a> {
     }
 }
 
+/// [`Tracer::intersect_simd`] as a [`Kernel`], so the backend picks the lane type.
+struct IntersectSimd<'t, 'a> {
+    tracer: &'t Tracer<'a>,
+    rays: &'t [Option<Ray>],
+    width: usize,
+    height: usize,
+    out: &'t mut [Option<Hit>],
+    stats: &'t mut TraversalStats,
+}
+
+impl Kernel for IntersectSimd<'_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Vf32>(self) {
+        self.tracer.intersect_simd::<V>(self.rays, self.width, self.height, self.out, self.stats);
+    }
+}
+
+/// [`Tracer::occluded_simd`] as a [`Kernel`].
+struct OccludedSimd<'t, 'a> {
+    tracer: &'t Tracer<'a>,
+    rays: &'t [Option<Ray>],
+    width: usize,
+    height: usize,
+    toward: Option<Vec3>,
+    out: &'t mut [bool],
+    stats: &'t mut TraversalStats,
+}
+
+impl Kernel for OccludedSimd<'_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Vf32>(self) {
+        self.tracer.occluded_simd::<V>(self.rays, self.width, self.height, self.toward, self.out, self.stats);
+    }
+}
+
 /// The origin shared by every valid ray of packets `set`, if there is one.
+#[inline(always)]
 fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Vec3> {
     let origin = set
         .iter()
@@ -467,6 +520,7 @@ fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Vec3> {
 }
 
 /// The cone of packets `set` when all their rays start at one point, else `None`.
+#[inline(always)]
 fn common_origin_cone<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Cone> {
     Cone::from_packets(common_origin(tile, set)?, &tile.packets, set)
 }
@@ -483,6 +537,7 @@ fn toward_cone(rays: &[Option<Ray>], toward: Vec3, spread_limit: f32) -> Option<
 }
 
 /// The frustum of the packets `set` of `tile` when all their rays start at one point, else `None`.
+#[inline(always)]
 fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Frustum> {
     Frustum::from_packets(common_origin(tile, set)?, &tile.packets, set)
 }
