@@ -132,6 +132,57 @@ pub(super) fn leaf_occlude<V: Vf32>(
     }
 }
 
+/// What a frustum walk does at a leaf. A trait rather than a closure so that it is always inlined into the
+/// walk, and so compiled with the kernel's target features (see [`raylab_simd::Kernel`]).
+trait FrustumLeaf {
+    /// Tests `leaf`; returns the distance beyond which no ray needs more leaves, and whether the walk can stop.
+    fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool);
+}
+
+/// Closest hits of packets `set`; `limit` is their farthest current hit.
+struct ClosestLeaves<'a, V: Vf32> {
+    tile: &'a mut PacketTile<V>,
+    set: &'a [usize],
+    cull: bool,
+    limit: f32,
+}
+
+impl<V: Vf32> FrustumLeaf for ClosestLeaves<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
+        if leaf_intersect(leaf, self.tile, self.set, self.cull, stats) {
+            self.limit = hit_limit(self.tile, self.set);
+        }
+        (self.limit, false)
+    }
+}
+
+/// Occlusion of packets `set`: the walk stops once every lane is blocked.
+struct BlockedLeaves<'a, V: Vf32> {
+    tile: &'a PacketTile<V>,
+    set: &'a [usize],
+    cull: bool,
+    blocked: &'a mut [V::Mask],
+}
+
+impl<V: Vf32> FrustumLeaf for BlockedLeaves<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
+        leaf_occlude(leaf, self.tile, self.set, self.cull, self.blocked, stats);
+        (f32::INFINITY, open_lanes(self.tile, self.set, self.blocked) == 0)
+    }
+}
+
+/// The lanes (bits) of packets `set` that are not blocked yet.
+#[inline(always)]
+pub(super) fn open_lanes<V: Vf32>(tile: &PacketTile<V>, set: &[usize], blocked: &[V::Mask]) -> u32 {
+    let mut open = 0;
+    for &j in set {
+        open |= (tile.packets[j].valid & !blocked[j]).bits();
+    }
+    open
+}
+
 /// The largest current hit distance over the lanes of packets `set` (infinite while any lane has none).
 #[inline(always)]
 pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> f32 {
@@ -150,13 +201,7 @@ impl KdTree {
         cull: bool,
         stats: &mut TraversalStats,
     ) {
-        let mut limit = f32::INFINITY;
-        self.traverse_frustum(f, stats, |leaf, stats| {
-            if leaf_intersect(leaf, tile, set, cull, stats) {
-                limit = hit_limit(tile, set);
-            }
-            (limit, false)
-        });
+        self.traverse_frustum(f, stats, &mut ClosestLeaves { tile, set, cull, limit: f32::INFINITY });
     }
 
     /// Marks in `blocked` the lanes of packets `set` that something blocks. The frustum `f` must bound the
@@ -171,22 +216,12 @@ impl KdTree {
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
-        self.traverse_frustum(f, stats, |leaf, stats| {
-            leaf_occlude(leaf, tile, set, cull, blocked, stats);
-            let all = set.iter().all(|&j| (tile.packets[j].valid & !blocked[j]).none());
-            (f32::INFINITY, all)
-        });
+        self.traverse_frustum(f, stats, &mut BlockedLeaves { tile, set, cull, blocked });
     }
 
-    /// Walks the leaves the frustum overlaps, roughly front to back. `leaf(leaf, stats)` returns the distance
-    /// beyond which no ray needs more leaves, and whether the walk can stop.
+    /// Walks the leaves the frustum overlaps, roughly front to back, handing each to `leaf`.
     #[inline(always)]
-    fn traverse_frustum<B: Bundle>(
-        &self,
-        f: &B,
-        stats: &mut TraversalStats,
-        mut leaf: impl FnMut(&Leaf, &mut TraversalStats) -> (f32, bool),
-    ) {
+    fn traverse_frustum<B: Bundle>(&self, f: &B, stats: &mut TraversalStats, leaf: &mut impl FrustumLeaf) {
         if self.triangles().is_empty() {
             return;
         }
@@ -215,7 +250,7 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let (limit, stop) = leaf(&Leaf { tree: self, ids: n.leaf_range(), bounds, near }, stats);
+            let (limit, stop) = leaf.visit(&Leaf { tree: self, ids: n.leaf_range(), bounds, near }, stats);
             if stop {
                 break;
             }

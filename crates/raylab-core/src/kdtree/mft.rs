@@ -9,7 +9,7 @@
 
 use raylab_simd::{VMask, Vf32};
 
-use super::frustum::{Leaf, front_and_back, hit_limit, leaf_intersect, leaf_occlude};
+use super::frustum::{Leaf, front_and_back, hit_limit, leaf_intersect, leaf_occlude, open_lanes};
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::Aabb;
@@ -90,8 +90,7 @@ impl<V: Vf32> Bundle4<V> for Frustum4<V> {
     }
 }
 
-/// What an MFT walk does at a leaf (a trait rather than a closure, so that it is always inlined into the
-/// walk: see [`raylab_simd::Kernel`]).
+/// What an MFT walk does at a leaf (a trait rather than a closure, like `frustum::FrustumLeaf`).
 trait MftLeaf<V: Vf32> {
     /// Tests `leaf` for the frustum lanes in `active` (bits), whose intervals start at `near`; returns each
     /// lane's distance limit and the lanes that are finished.
@@ -135,11 +134,7 @@ impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
             if active >> i & 1 == 1 {
                 let leaf = Leaf { near: near[i], ids: leaf.ids.clone(), ..*leaf };
                 leaf_occlude(&leaf, self.tile, set, self.cull, self.blocked, stats);
-                let mut open = 0;
-                for &j in set {
-                    open |= (self.tile.packets[j].valid & !self.blocked[j]).bits();
-                }
-                if open == 0 {
+                if open_lanes(self.tile, set, self.blocked) == 0 {
                     self.done |= 1 << i;
                 }
             }

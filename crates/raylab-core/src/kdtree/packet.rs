@@ -22,6 +22,57 @@ struct Entry<V: Vf32> {
     t_far: V,
 }
 
+/// What a packet walk does at a leaf. A trait rather than a closure so that it is always inlined into the
+/// walk, and so compiled with the kernel's target features (see [`raylab_simd::Kernel`]).
+trait PacketLeaf<V: Vf32> {
+    /// Tests the leaf's triangles `ids` for the `active` lanes; returns each lane's current limit (its
+    /// closest hit, or `tmax`) and the lanes that are finished.
+    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask) -> (V, V::Mask);
+}
+
+/// Closest hits, kept in `hits`.
+struct ClosestHits<'a, V: Vf32> {
+    tree: &'a KdTree,
+    p: &'a RayPacket<V>,
+    hits: &'a mut PacketHits<V>,
+    tests: u64,
+}
+
+impl<V: Vf32> PacketLeaf<V> for ClosestHits<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask) -> (V, V::Mask) {
+        for &id in &self.tree.tri_ids()[ids] {
+            self.tests += 1;
+            intersect_packet(self.p, self.hits, self.tree.triangles().get(id), id, active);
+        }
+        (self.hits.t, V::Mask::from_bits(0))
+    }
+}
+
+/// Any hit: a lane is finished once something blocks it.
+struct Blockers<'a, V: Vf32> {
+    tree: &'a KdTree,
+    p: &'a RayPacket<V>,
+    blocked: V::Mask,
+    tests: u64,
+}
+
+impl<V: Vf32> PacketLeaf<V> for Blockers<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask) -> (V, V::Mask) {
+        let mut open = active & !self.blocked;
+        for &id in &self.tree.tri_ids()[ids] {
+            if open.none() {
+                break;
+            }
+            self.tests += 1;
+            self.blocked = self.blocked | occlude_packet(self.p, self.tree.triangles().get(id), open);
+            open = open & !self.blocked;
+        }
+        (self.p.tmax, self.blocked)
+    }
+}
+
 const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 
 /// A fixed-size traversal stack (no allocation per packet); each inner node pushes at most one entry, so the
@@ -42,47 +93,23 @@ impl KdTree {
     /// search only closer hits). Counts nodes, leaves and tests; the caller counts rays and packets.
     #[inline(always)]
     pub fn intersect_packet<V: Vf32>(&self, p: &RayPacket<V>, hits: &mut PacketHits<V>, stats: &mut TraversalStats) {
-        let mut tests = 0u64;
-        self.traverse_packet(p, stats, |ids, active| {
-            for &id in &self.tri_ids()[ids] {
-                tests += 1;
-                intersect_packet(p, hits, self.triangles().get(id), id, active);
-            }
-            (hits.t, V::Mask::from_bits(0))
-        });
-        stats.isect_tests += tests;
+        let mut leaf = ClosestHits { tree: self, p, hits, tests: 0 };
+        self.traverse_packet(p, stats, &mut leaf);
+        stats.isect_tests += leaf.tests;
     }
 
     /// The lanes whose rays are blocked within `(tmin, tmax]`.
     #[inline(always)]
     pub fn occluded_packet<V: Vf32>(&self, p: &RayPacket<V>, stats: &mut TraversalStats) -> V::Mask {
-        let mut blocked = V::Mask::from_bits(0);
-        let mut tests = 0u64;
-        self.traverse_packet(p, stats, |ids, active| {
-            let mut open = active & !blocked;
-            for &id in &self.tri_ids()[ids] {
-                if open.none() {
-                    break;
-                }
-                tests += 1;
-                blocked = blocked | occlude_packet(p, self.triangles().get(id), open);
-                open = open & !blocked;
-            }
-            (p.tmax, blocked)
-        });
-        stats.isect_tests += tests;
-        blocked
+        let mut leaf = Blockers { tree: self, p, blocked: V::Mask::from_bits(0), tests: 0 };
+        self.traverse_packet(p, stats, &mut leaf);
+        stats.isect_tests += leaf.tests;
+        leaf.blocked
     }
 
-    /// Walks the leaves the packet's rays cross. `leaf(ids, active)` tests a leaf for the `active` lanes and
-    /// returns each lane's current limit (its closest hit, or `tmax`) and the lanes that are finished.
+    /// Walks the leaves the packet's rays cross, handing each to `leaf`.
     #[inline(always)]
-    fn traverse_packet<V: Vf32>(
-        &self,
-        p: &RayPacket<V>,
-        stats: &mut TraversalStats,
-        mut leaf: impl FnMut(std::ops::Range<usize>, V::Mask) -> (V, V::Mask),
-    ) {
+    fn traverse_packet<V: Vf32>(&self, p: &RayPacket<V>, stats: &mut TraversalStats, leaf: &mut impl PacketLeaf<V>) {
         if self.triangles().is_empty() || p.valid.none() {
             return;
         }
@@ -140,7 +167,7 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let (limit, finished) = leaf(n.leaf_range(), active & !done);
+            let (limit, finished) = leaf.visit(n.leaf_range(), active & !done);
             done = done | finished;
             if (p.valid & !done).none() {
                 break;

@@ -511,12 +511,13 @@ fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Vec3> {
         })?
         .origin;
     let o = [V::splat(origin.x), V::splat(origin.y), V::splat(origin.z)];
-    let same = set.iter().all(|&j| {
+    let mut elsewhere = 0;
+    for &j in set {
         let p = &tile.packets[j];
         let at_origin = p.org[0].eq(o[0]) & p.org[1].eq(o[1]) & p.org[2].eq(o[2]);
-        (p.valid & !at_origin).none()
-    });
-    same.then_some(origin)
+        elsewhere |= (p.valid & !at_origin).bits();
+    }
+    (elsewhere == 0).then_some(origin)
 }
 
 /// The cone of packets `set` when all their rays start at one point, else `None`.
