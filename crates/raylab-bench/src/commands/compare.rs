@@ -290,10 +290,14 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         let _ = writeln!(md, "| median of {} | {} | {:.3} | {} |", a.builds, t, s, e);
     }
     if !coherent.is_empty() {
+        let backend = TraceOptions::default().backend;
+        let packet = format!("{}x2", backend.lanes() / 2);
         let _ = writeln!(
             md,
             "\nCoherent methods against Embree's best packet or stream API for the same rays and thread count \
-             (N = nodes per 2x2 packet, I = triangle tests per 2x2 packet, culled = packet/leaf visits culled):\n"
+             ({} backend; N = nodes per {packet} packet, I = triangle tests per {packet} packet, culled = \
+             packet/leaf visits culled):\n",
+            backend.name()
         );
         let _ = writeln!(
             md,
