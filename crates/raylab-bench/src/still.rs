@@ -47,8 +47,16 @@ pub fn render_still(
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     let t0 = Instant::now();
     let reference = (options.method == Method::Reference).then(|| BruteForce::new(&loaded));
-    let mbvh = options.method.uses_mbvh().then(|| pool.install(|| Mbvh::build(&loaded)));
-    let dacrt = options.method.uses_dacrt().then(|| Dacrt::new(&loaded));
+    let mbvh = options.method.uses_mbvh().then(|| {
+        let mut m = pool.install(|| Mbvh::build(&loaded));
+        m.backend = options.backend;
+        m
+    });
+    let dacrt = options.method.uses_dacrt().then(|| {
+        let mut d = Dacrt::new(&loaded);
+        d.backend = options.backend;
+        d
+    });
     let frame = {
         let mut tracer = Tracer::new(&tree, reference.as_ref(), options);
         if let Some(m) = &mbvh {

@@ -80,8 +80,16 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string());
         pool.map(|p| with_spinner("building MBVH", || p.install(|| Mbvh::build(&scene))))
     });
-    let mbvh = mbvh.transpose()?;
-    let dacrt = options.method.uses_dacrt().then(|| Dacrt::new(&scene));
+    // The structures take the backend asked for, like the kd-tree kernels.
+    let mbvh = mbvh.transpose()?.map(|mut m| {
+        m.backend = options.backend;
+        m
+    });
+    let dacrt = options.method.uses_dacrt().then(|| {
+        let mut d = Dacrt::new(&scene);
+        d.backend = options.backend;
+        d
+    });
     let mut tracer = Tracer::new(&tree, Some(&reference), options);
     if let Some(m) = &mbvh {
         tracer = tracer.with_mbvh(m);

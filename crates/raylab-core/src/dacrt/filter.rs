@@ -2,18 +2,20 @@
 //! the ray list (Afra 2012 moves rays rather than indices, so later passes read them linearly).
 //!
 //! A node classifies its rays against both children's boxes in one pass, loading each ray into SIMD lanes
-//! once. The box test runs on four rays at once in SIMD lanes ([`Vf32`]): each axis's entry and exit are taken in
+//! once. The box test runs on four or eight rays at once in SIMD lanes ([`Vf32`], the backend's widest, run
+//! through [`raylab_simd::dispatch`]): each axis's entry and exit are taken in
 //! the order the direction's sign gives and merged with comparisons that ignore NaN, so a zero direction
 //! component with the origin on a slab plane (`0 * inf`) leaves that axis unconstrained. Boxes are padded by a
 //! few ulps of their coordinates and far distances widened, so rounding never drops a ray that touches a
 //! triangle inside: filtering may keep extra rays, never lose one.
 
 use glam::Vec3;
-use raylab_simd::{VMask, Vf32};
+use raylab_simd::{Backend, Kernel, VMask, Vf32};
 
 use super::partition::partition;
 use super::records::RayRecord;
 use crate::aabb::Aabb;
+use crate::packet::MAX_LANES;
 
 /// Relative widening of a box's far distance (pbrt's `1 + 2 gamma(3)`).
 const FAR_SLACK: f32 = 2.0 * 3.0 * f32::EPSILON;
@@ -51,24 +53,53 @@ const SPREAD: [u32; 16] = {
 };
 
 /// Sets bit `k` of `flags[i]` when ray `i` enters `boxes[k]` within its interval (the rays are loaded into
-/// lanes once for all `N` boxes).
-pub(super) fn classify<V: Vf32, const N: usize>(rays: &[RayRecord], boxes: &[FilterBox; N], flags: &mut Vec<u8>) {
-    debug_assert!(V::LANES == 4 && N <= 8);
+/// lanes once for all `N` boxes), with `backend`'s widest lanes.
+pub(super) fn classify<const N: usize>(
+    backend: Backend,
+    rays: &[RayRecord],
+    boxes: &[FilterBox; N],
+    flags: &mut Vec<u8>,
+) {
+    raylab_simd::dispatch(backend, Classify { rays, boxes, flags });
+}
+
+/// [`classify_lanes`] as a [`Kernel`].
+struct Classify<'a, const N: usize> {
+    rays: &'a [RayRecord],
+    boxes: &'a [FilterBox; N],
+    flags: &'a mut Vec<u8>,
+}
+
+impl<const N: usize> Kernel for Classify<'_, N> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Vf32>(self) {
+        classify_lanes::<V, N>(self.rays, self.boxes, self.flags);
+    }
+}
+
+/// [`classify`] with lane type `V`.
+#[inline(always)]
+fn classify_lanes<V: Vf32, const N: usize>(rays: &[RayRecord], boxes: &[FilterBox; N], flags: &mut Vec<u8>) {
+    debug_assert!(V::LANES <= 8 && N <= 8);
+    let lanes = V::LANES;
     flags.clear();
-    flags.resize(rays.len().next_multiple_of(4), 0);
+    flags.resize(rays.len().next_multiple_of(lanes), 0);
     let splat = |v: Vec3| [V::splat(v.x), V::splat(v.y), V::splat(v.z)];
     let corners: [([V; 3], [V; 3]); N] = std::array::from_fn(|k| (splat(boxes[k].min), splat(boxes[k].max)));
     let zero = V::splat(0.0);
     let slack = V::splat(FAR_SLACK);
-    for (block, out) in rays.chunks(4).zip(flags.chunks_exact_mut(4)) {
+    for (block, out) in rays.chunks(lanes).zip(flags.chunks_exact_mut(lanes)) {
         // A short last block repeats its first ray in the missing lanes.
-        let r = |k: usize| &block[k.min(block.len() - 1)];
-        let rs = [r(0), r(1), r(2), r(3)];
-        let org = [gather::<V>(rs, |r| r.org.x), gather(rs, |r| r.org.y), gather(rs, |r| r.org.z)];
-        let inv = [gather::<V>(rs, |r| r.inv.x), gather(rs, |r| r.inv.y), gather(rs, |r| r.inv.z)];
+        let mut rs = [&block[0]; MAX_LANES];
+        for (k, r) in rs.iter_mut().enumerate().take(lanes) {
+            *r = &block[k.min(block.len() - 1)];
+        }
+        let org = [gather::<V>(&rs, |r| r.org.x), gather(&rs, |r| r.org.y), gather(&rs, |r| r.org.z)];
+        let inv = [gather::<V>(&rs, |r| r.inv.x), gather(&rs, |r| r.inv.y), gather(&rs, |r| r.inv.z)];
         let neg = [inv[0].lt(zero), inv[1].lt(zero), inv[2].lt(zero)];
-        let (tmin, tmax) = (gather::<V>(rs, |r| r.tmin), gather::<V>(rs, |r| r.tmax));
-        let mut bytes = 0u32;
+        let (tmin, tmax) = (gather::<V>(&rs, |r| r.tmin), gather::<V>(&rs, |r| r.tmax));
+        let mut bytes = 0u64;
         for (k, (bmin, bmax)) in corners.iter().enumerate() {
             let (mut near, mut far) = (tmin, tmax);
             for a in 0..3 {
@@ -80,21 +111,26 @@ pub(super) fn classify<V: Vf32, const N: usize>(rays: &[RayRecord], boxes: &[Fil
                 near = V::select(enter.gt(near), enter, near);
                 far = V::select(leave.lt(far), leave, far);
             }
-            bytes |= SPREAD[near.le(far + far.abs() * slack).bits() as usize] << k;
+            let bits = near.le(far + far.abs() * slack).bits() as usize;
+            bytes |= (u64::from(SPREAD[bits & 15]) | u64::from(SPREAD[bits >> 4 & 15]) << 32) << k;
         }
-        out.copy_from_slice(&bytes.to_le_bytes());
+        out.copy_from_slice(&bytes.to_le_bytes()[..lanes]);
     }
 }
 
-/// One field of four rays in SIMD lanes.
+/// One field of the rays `rs` in SIMD lanes.
 #[inline(always)]
-fn gather<V: Vf32>(rs: [&RayRecord; 4], f: impl Fn(&RayRecord) -> f32) -> V {
-    V::from_slice(&[f(rs[0]), f(rs[1]), f(rs[2]), f(rs[3])])
+fn gather<V: Vf32>(rs: &[&RayRecord; MAX_LANES], f: impl Fn(&RayRecord) -> f32) -> V {
+    let mut v = [0.0; MAX_LANES];
+    for (lane, r) in v.iter_mut().zip(rs).take(V::LANES) {
+        *lane = f(r);
+    }
+    V::from_slice(&v[..V::LANES])
 }
 
 /// Moves the rays of `rays` that enter `b` to the front and returns how many there are; `flags` is scratch.
-pub(super) fn filter<V: Vf32>(rays: &mut [RayRecord], b: &FilterBox, flags: &mut Vec<u8>) -> usize {
-    classify::<V, 1>(rays, &[*b], flags);
+pub(super) fn filter(backend: Backend, rays: &mut [RayRecord], b: &FilterBox, flags: &mut Vec<u8>) -> usize {
+    classify::<1>(backend, rays, &[*b], flags);
     let n = rays.len();
     partition(rays, &mut flags[..n], |f| f != 0)
 }
@@ -104,7 +140,14 @@ mod tests {
     use super::*;
     use crate::ray::Ray;
 
-    fn check<V: Vf32>() {
+    #[test]
+    fn every_backend_keeps_exactly_the_rays_that_enter() {
+        for backend in Backend::available() {
+            check(backend);
+        }
+    }
+
+    fn check(backend: Backend) {
         let b = FilterBox::new(&Aabb::new(Vec3::ZERO, Vec3::ONE));
         let cases = [
             (Ray::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z), true),
@@ -123,24 +166,13 @@ mod tests {
         let mut rays: Vec<RayRecord> =
             cases.iter().enumerate().map(|(i, (r, _))| RayRecord::new(r, i as u32)).collect();
         let mut flags = Vec::new();
-        let k = filter::<V>(&mut rays, &b, &mut flags);
+        let k = filter(backend, &mut rays, &b, &mut flags);
         let mut kept: Vec<u32> = rays[..k].iter().map(|r| r.id).collect();
         kept.sort_unstable();
         let want: Vec<u32> = cases.iter().enumerate().filter(|c| c.1.1).map(|(i, _)| i as u32).collect();
-        assert_eq!(kept, want);
+        assert_eq!(kept, want, "{backend:?}");
         let mut all: Vec<u32> = rays.iter().map(|r| r.id).collect();
         all.sort_unstable();
         assert!(all.iter().copied().eq(0..cases.len() as u32));
-    }
-
-    #[test]
-    fn scalar_lanes() {
-        check::<raylab_simd::scalar::F32x4>();
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[test]
-    fn sse_lanes() {
-        check::<raylab_simd::sse::F32x4>();
     }
 }

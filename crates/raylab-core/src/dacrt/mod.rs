@@ -19,7 +19,7 @@ pub use split::SplitRule;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use raylab_simd::{Backend, Vf32};
+use raylab_simd::Backend;
 use serde::{Deserialize, Serialize};
 
 use crate::ray::{Hit, Ray};
@@ -147,13 +147,10 @@ impl Dacrt {
                 params: *p,
                 answer,
                 flags: std::mem::take(&mut scratch.flags),
+                backend: self.backend,
                 stats: TraversalStats::default(),
             };
-            match self.backend {
-                #[cfg(target_arch = "x86_64")]
-                Backend::Sse | Backend::Avx2 => self.start::<raylab_simd::sse::F32x4, A>(&mut walk, &mut scratch),
-                _ => self.start::<raylab_simd::scalar::F32x4, A>(&mut walk, &mut scratch),
-            }
+            self.start(&mut walk, &mut scratch);
             scratch.flags = walk.flags;
             *stats += walk.stats;
         }
@@ -161,12 +158,12 @@ impl Dacrt {
     }
 
     /// Filters the rays against the scene's box, then recurses.
-    fn start<V: Vf32, A: Answer>(&self, walk: &mut Walk<A>, scratch: &mut Scratch) {
+    fn start<A: Answer>(&self, walk: &mut Walk<A>, scratch: &mut Scratch) {
         let Scratch { tris, rays, .. } = scratch;
         walk.stats.box_tests += rays.len() as u64;
-        let k = filter::filter::<V>(rays, &filter::FilterBox::new(&self.root.bounds), &mut walk.flags);
+        let k = filter::filter(walk.backend, rays, &filter::FilterBox::new(&self.root.bounds), &mut walk.flags);
         if k > 0 {
-            walk.recurse::<V>(&mut rays[..k], tris, self.root, 0);
+            walk.recurse(&mut rays[..k], tris, self.root, 0);
         }
     }
 

@@ -3,14 +3,14 @@
 //! left naively once a node is small. The half nearer to most rays goes first, so their closest hits shorten
 //! their intervals before the other half is filtered.
 
-use raylab_simd::{VMask, Vf32};
+use raylab_simd::{Backend, Kernel, VMask, Vf32};
 
 use super::DacrtParams;
 use super::filter::{FilterBox, classify};
 use super::partition::partition;
 use super::records::{RayRecord, SetBounds, TriRecord};
 use super::split::divide;
-use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
+use crate::packet::{MAX_LANES, PacketHits, RayPacket, intersect_packet, occlude_packet};
 use crate::ray::Hit;
 use crate::stats::TraversalStats;
 use crate::triangle::TriangleSoup;
@@ -22,23 +22,38 @@ const MAX_DEPTH: u32 = 96;
 const ORDER_SAMPLES: usize = 16;
 
 /// What a leaf does with the rays that reach it: closest hits, occlusion or first blockers. The rays are
-/// packed four at a time into temporary SoA packets (as MBVH RS leaves do) and each triangle is tested against
-/// a packet at once with the watertight test, bit for bit what the single-ray test reports.
+/// packed into temporary SoA packets of the backend's width (as MBVH RS leaves do) and each triangle is
+/// tested against a packet at once with the watertight test, bit for bit what the single-ray test reports.
 pub(super) trait Answer {
     /// Tests every ray of `rays` against every triangle of `tris`, updating the rays' intervals.
     fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]);
 }
 
-/// Four rays (or fewer, at the end) in a temporary packet.
-fn packets<V: Vf32>(rays: &mut [RayRecord]) -> impl Iterator<Item = (&mut [RayRecord], RayPacket<V>)> {
-    rays.chunks_mut(4).map(|group| {
-        let mut lanes = [None; 4];
-        for (l, r) in lanes.iter_mut().zip(group.iter()) {
-            *l = Some(r.ray());
-        }
-        let p = RayPacket::<V>::new(&lanes[..group.len()]);
-        (group, p)
-    })
+/// `V::LANES` rays (or fewer, at the end) in a temporary packet.
+#[inline(always)]
+fn packet<V: Vf32>(group: &[RayRecord]) -> RayPacket<V> {
+    let mut lanes = [None; MAX_LANES];
+    for (l, r) in lanes.iter_mut().zip(group.iter()) {
+        *l = Some(r.ray());
+    }
+    RayPacket::<V>::new(&lanes[..group.len()])
+}
+
+/// A leaf's work as a [`Kernel`], so that it runs with the backend's widest lanes (the recursion itself
+/// cannot be compiled into the AVX2 entry point).
+struct LeafKernel<'a, A> {
+    answer: &'a mut A,
+    soup: &'a TriangleSoup,
+    rays: &'a mut [RayRecord],
+    tris: &'a [TriRecord],
+}
+
+impl<A: Answer> Kernel for LeafKernel<'_, A> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Vf32>(self) {
+        self.answer.leaf::<V>(self.soup, self.rays, self.tris);
+    }
 }
 
 /// Closest hits, written at each ray's id.
@@ -47,8 +62,10 @@ pub(super) struct Closest<'a> {
 }
 
 impl Answer for Closest<'_> {
+    #[inline(always)]
     fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]) {
-        for (group, p) in packets::<V>(rays) {
+        for group in rays.chunks_mut(V::LANES) {
+            let p = packet::<V>(group);
             let mut hits = PacketHits::new(&p);
             for t in tris {
                 intersect_packet(&p, &mut hits, soup.get(t.id), t.id, p.valid);
@@ -68,9 +85,10 @@ impl Answer for Closest<'_> {
 }
 
 /// The lanes of packet `p` that some triangle of `tris` blocks, and for each lane the first such triangle.
-fn blocked<V: Vf32>(p: &RayPacket<V>, soup: &TriangleSoup, tris: &[TriRecord]) -> (u32, [u32; 4]) {
+#[inline(always)]
+fn blocked<V: Vf32>(p: &RayPacket<V>, soup: &TriangleSoup, tris: &[TriRecord]) -> (u32, [u32; MAX_LANES]) {
     let mut open = p.valid;
-    let mut first = [u32::MAX; 4];
+    let mut first = [u32::MAX; MAX_LANES];
     for t in tris {
         let hit = occlude_packet(p, soup.get(t.id), open);
         if hit.any() {
@@ -95,9 +113,10 @@ pub(super) struct Any<'a> {
 }
 
 impl Answer for Any<'_> {
+    #[inline(always)]
     fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]) {
-        for (group, p) in packets::<V>(rays) {
-            let (bits, _) = blocked(&p, soup, tris);
+        for group in rays.chunks_mut(V::LANES) {
+            let (bits, _) = blocked(&packet::<V>(group), soup, tris);
             for (k, r) in group.iter_mut().enumerate() {
                 if bits >> k & 1 == 1 {
                     self.out[r.id as usize] = true;
@@ -114,9 +133,10 @@ pub(super) struct Blocker<'a> {
 }
 
 impl Answer for Blocker<'_> {
+    #[inline(always)]
     fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]) {
-        for (group, p) in packets::<V>(rays) {
-            let (bits, first) = blocked(&p, soup, tris);
+        for group in rays.chunks_mut(V::LANES) {
+            let (bits, first) = blocked(&packet::<V>(group), soup, tris);
             for (k, r) in group.iter_mut().enumerate() {
                 if bits >> k & 1 == 1 {
                     self.out[r.id as usize] = Some(first[k]);
@@ -134,12 +154,14 @@ pub(super) struct Walk<'a, A> {
     pub answer: A,
     /// Scratch flags for the filter.
     pub flags: Vec<u8>,
+    /// SIMD backend of the filter (its widest lanes; leaves test four rays at a time).
+    pub backend: Backend,
     pub stats: TraversalStats,
 }
 
 impl<A: Answer> Walk<'_, A> {
     /// Traces `rays` against `tris` (bounded by `b`).
-    pub fn recurse<V: Vf32>(&mut self, rays: &mut [RayRecord], tris: &mut [TriRecord], b: SetBounds, depth: u32) {
+    pub fn recurse(&mut self, rays: &mut [RayRecord], tris: &mut [TriRecord], b: SetBounds, depth: u32) {
         self.stats.nodes += 1;
         let p = self.params;
         let small = tris.len() <= p.leaf_tris || rays.len() <= p.leaf_rays;
@@ -147,7 +169,8 @@ impl<A: Answer> Walk<'_, A> {
         let Some(s) = split else {
             self.stats.leaves += 1;
             self.stats.isect_tests += (rays.len() * tris.len()) as u64;
-            self.answer.leaf::<V>(self.soup, rays, tris);
+            let leaf = LeafKernel { answer: &mut self.answer, soup: self.soup, rays, tris };
+            raylab_simd::dispatch(self.backend, leaf);
             return;
         };
         let step = rays.len().div_ceil(ORDER_SAMPLES);
@@ -159,21 +182,21 @@ impl<A: Answer> Walk<'_, A> {
         // One pass against both boxes: [near (maybe far too) | far only | neither].
         let boxes = [FilterBox::new(&near_b.bounds), FilterBox::new(&far_b.bounds)];
         self.stats.box_tests += 2 * rays.len() as u64;
-        classify::<V, 2>(rays, &boxes, &mut self.flags);
+        classify(self.backend, rays, &boxes, &mut self.flags);
         let n = rays.len();
         let to_near = partition(rays, &mut self.flags[..n], |f| f & 1 != 0);
         let far_only = partition(&mut rays[to_near..], &mut self.flags[to_near..n], |f| f & 2 != 0);
         if to_near > 0 {
-            self.recurse::<V>(&mut rays[..to_near], near, near_b, depth + 1);
+            self.recurse(&mut rays[..to_near], near, near_b, depth + 1);
         }
         // The near half's rays test the far box again with their shortened intervals; those that enter it go
         // to the back of their range, next to the far-only rays.
         let near_rays = &mut rays[..to_near];
         self.stats.box_tests += near_rays.len() as u64;
-        classify::<V, 1>(near_rays, &[boxes[1]], &mut self.flags);
+        classify(self.backend, near_rays, &[boxes[1]], &mut self.flags);
         let stay = partition(near_rays, &mut self.flags[..to_near], |f| f == 0);
         if stay < to_near + far_only {
-            self.recurse::<V>(&mut rays[stay..to_near + far_only], far, far_b, depth + 1);
+            self.recurse(&mut rays[stay..to_near + far_only], far, far_b, depth + 1);
         }
     }
 }
