@@ -15,7 +15,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{MAX_LANES, RayPacket, tile::Bundle, tile::Bundle4};
+use super::{RayPacket, bundle_lanes, tile::Bundle, tile::Bundle4};
 
 /// A cone bounding a bundle of rays from one origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -138,13 +138,7 @@ impl<V: Vf32> Cone4<V> {
         assert!(V::LANES >= 4, "MFT traces four cones");
         let origin = c.iter().flatten().next()?.origin;
         assert!(c.iter().flatten().all(|x| x.origin == origin), "MFT cones share their apex");
-        let lanes = |g: &dyn Fn(&Cone) -> f32, empty: f32| {
-            let mut a = [empty; MAX_LANES];
-            for (lane, x) in a.iter_mut().zip(&c) {
-                *lane = x.as_ref().map_or(empty, g);
-            }
-            V::from_slice(&a[..V::LANES])
-        };
+        let lanes = |g: &dyn Fn(&Cone) -> f32, empty: f32| bundle_lanes::<V, _>(&c, g, empty);
         let valid = c.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
         Some(Self {
             origin,

@@ -130,6 +130,17 @@ impl<V: Vf32> RayPacket<V> {
     }
 }
 
+/// One field of up to four bundles (MFT's frustums or cones) in the first four lanes, `empty` in the others
+/// and where a bundle is missing.
+#[inline(always)]
+pub(crate) fn bundle_lanes<V: Vf32, B>(bundles: &[Option<B>; 4], field: &dyn Fn(&B) -> f32, empty: f32) -> V {
+    let mut a = [empty; MAX_LANES];
+    for (lane, b) in a.iter_mut().zip(bundles) {
+        *lane = b.as_ref().map_or(empty, field);
+    }
+    V::from_slice(&a[..V::LANES])
+}
+
 /// The first `V::LANES` values of `field` as a vector.
 #[inline(always)]
 fn load<V: Vf32>(field: &[f32; MAX_LANES]) -> V {
