@@ -4,7 +4,7 @@
 //! portable [`scalar::F32x4`], which has the same API and the same per-lane semantics (including how `min`,
 //! `max` and comparisons treat NaN), so tests can run every kernel both ways and compare. Backends are
 //! chosen once, when a tracer is set up ([`Backend::detect`], which checks the CPU at run time), never per
-//! ray; a kernel runs with a backend's lane type through [`dispatch`] or [`dispatch4`].
+//! ray; a kernel runs with a backend's lane type through [`dispatch`].
 //!
 //! This is the only raylab crate that may use `unsafe`; each block says why it is sound.
 
@@ -105,8 +105,8 @@ pub enum Backend {
     /// SSE2 on x86-64 (always present there): four lanes.
     Sse,
     /// AVX2 and FMA on x86-64 CPUs that have them (checked at run time): eight lanes for the kernels that
-    /// take any width (packets of 4x2 rays); kernels of four-wide structures (MBVH nodes, DACRT's ray
-    /// filter) use SSE with it.
+    /// take any width (4x2 ray packets, DACRT's filter and leaves); the MBVH kernels, whose vectors are its
+    /// four-wide nodes, use SSE with it.
     Avx2,
 }
 

@@ -154,7 +154,7 @@ pub(super) struct Walk<'a, A> {
     pub answer: A,
     /// Scratch flags for the filter.
     pub flags: Vec<u8>,
-    /// SIMD backend of the filter (its widest lanes; leaves test four rays at a time).
+    /// SIMD backend of the filter and the leaves (each runs with its widest lanes).
     pub backend: Backend,
     pub stats: TraversalStats,
 }

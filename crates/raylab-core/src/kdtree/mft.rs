@@ -224,6 +224,7 @@ impl KdTree {
             let mut near_lanes = [0.0f32; MAX_LANES];
             near.write_to(&mut near_lanes[..V::LANES]);
             let near4 = std::array::from_fn(|i| near_lanes[i]);
+            // Each frustum lane has its own entry distance: the visitor sets `near` from `near4` per lane.
             let leaf_at = Leaf { tree: self, ids: n.leaf_range(), bounds, near: 0.0 };
             let (limit, finished) = leaf.visit(&leaf_at, near4, (active & !done).bits(), stats);
             done = done | V::Mask::from_bits(finished);
