@@ -238,7 +238,8 @@ pub struct ShadeArgs {
     /// ms4, ms8, ms16, ms32 (that many stratified samples on the spherical light).
     #[arg(long, default_value = "hard")]
     pub shadows: ShadowKind,
-    /// How multi-sampled shadows bound each point's samples: packets, pyramid or cone.
+    /// How multi-sampled shadows bound each point's samples: packets, fitted (a pyramid fitted to them), or the
+    /// pyramid or cone around the light.
     #[arg(long, default_value = "packets")]
     pub ms_bound: SampleBound,
     /// Edge width at which a point counts as fully shadowed, in world units (default: the light's radius).

@@ -80,7 +80,7 @@ fn bad_input_is_refused_with_a_clear_error() {
         (&["render", "--scene", "arena", "--edge-radius", "-1"], ">= 0"),
         (&["render", "--scene", "arena", "--light-radius", "nan"], ">= 0"),
         (&["render", "--scene", "arena", "--depth", "99"], "0..=16"),
-        (&["render", "--scene", "arena", "--ms-bound", "box"], "packets, pyramid or cone"),
+        (&["render", "--scene", "arena", "--ms-bound", "box"], "packets, fitted, pyramid or cone"),
         (&["trace", "--scene", "arena", "--kind", "glossy"], "primary, shadow, diffuse"),
         (&["trace", "--scene", "arena", "--method", "warp"], "mono"),
         (&["trace", "--scene", "arena", "--threads", "0"], "1..=1024"),

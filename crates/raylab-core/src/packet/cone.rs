@@ -60,20 +60,48 @@ impl Cone {
             t_min = t_min.min(t0);
             t_max = t_max.max(t1);
         }
-        // Pad for the rounding of the unit directions and of the later f32 products.
-        let tan_alpha = (tan_max * (1.0 + 1e-4) + 1e-5) as f32;
+        Some(Self::with_axis(origin, axis, pad_tan(tan_max), t_min.max(0.0), t_max))
+    }
+
+    /// The cone from `apex` tangent to the sphere of radius `radius` about `center`: it holds every ray from
+    /// `apex` to a point of the sphere, so it bounds a point's shadow samples on a spherical light before
+    /// any of them is drawn (the cone proxy of thesis 4.1.9 and Figure 4.5). Depths run from 0 to the far
+    /// side of the sphere. `None` when `apex` is inside or near the sphere (the cone would open wider than
+    /// [`Cone::PROXY_MAX_TAN`]) or an input is not finite.
+    pub fn around_sphere(apex: Vec3, center: Vec3, radius: f32) -> Option<Self> {
+        let to = (center - apex).as_dvec3();
+        let d = to.length();
+        // Pad the radius for the rounding of sample points on the sphere (their coordinates carry an error
+        // relative to their size, not to the radius).
+        let r = radius.max(0.0) as f64 * (1.0 + 1e-5) + center.abs().max_element() as f64 * 1e-6;
+        if !(d.is_finite() && r.is_finite() && d > r) {
+            return None;
+        }
+        let tan = r / (d * d - r * r).sqrt();
+        if tan > Self::PROXY_MAX_TAN as f64 {
+            return None;
+        }
+        let axis = (to / d).as_vec3();
+        Some(Self::with_axis(apex, axis, pad_tan(tan), 0.0, ((d + r) * (1.0 + 1e-5)) as f32))
+    }
+
+    /// Widest cone [`Cone::around_sphere`] builds (tangent of the half-angle, about 72 degrees).
+    pub const PROXY_MAX_TAN: f32 = 3.0;
+
+    /// The cone about unit `axis` with the per-axis precomputation of Listing 4.4.
+    fn with_axis(origin: Vec3, axis: Vec3, tan_alpha: f32, t_min: f32, t_max: f32) -> Self {
         let beta = axis.to_array().map(|v| tan_alpha * (1.0 - v * v).max(0.0).sqrt());
         let v = axis.to_array();
-        Some(Self {
+        Self {
             origin,
             axis,
             tan_alpha,
             inv_hi: std::array::from_fn(|k| 1.0 / (v[k] + beta[k])),
             inv_lo: std::array::from_fn(|k| 1.0 / (v[k] - beta[k])),
-            t_min: t_min.max(0.0),
+            t_min,
             t_max,
             origin_slack: 0.0,
-        })
+        }
     }
 
     /// The cone of the valid rays of `packets[set]`, which all start at `origin`.
@@ -111,12 +139,22 @@ impl Bundle for Cone {
         if dist.abs() <= slack {
             return (0.0, f32::INFINITY);
         }
-        let (near_d, far_d) = if dist > 0.0 { (dist - slack, dist + slack) } else { (dist + slack, dist - slack) };
         let fix = |t: f32| if t < 0.0 || t.is_nan() { f32::INFINITY } else { t };
+        if slack == 0.0 {
+            // Rays that start at the apex (shadow samples, camera tiles): Listing 4.3's two products.
+            let (a, b) = (fix(dist * self.inv_hi[k]), fix(dist * self.inv_lo[k]));
+            return (a.min(b), a.max(b));
+        }
+        let (near_d, far_d) = if dist > 0.0 { (dist - slack, dist + slack) } else { (dist + slack, dist - slack) };
         let (a, b) = (fix(near_d * self.inv_hi[k]), fix(near_d * self.inv_lo[k]));
         let (c, d) = (fix(far_d * self.inv_hi[k]), fix(far_d * self.inv_lo[k]));
         (a.min(b).min(c.min(d)), a.max(b).max(c.max(d)))
     }
+}
+
+/// A half-angle tangent widened for the rounding of unit directions and of the f32 products of a walk.
+pub(super) fn pad_tan(tan: f64) -> f32 {
+    (tan * (1.0 + 1e-4) + 1e-5) as f32
 }
 
 /// Four cones with one apex, one per SIMD lane (MFT over cones, thesis 4.1.9).

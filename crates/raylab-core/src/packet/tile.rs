@@ -239,6 +239,20 @@ impl Frustum {
         Some(f)
     }
 
+    /// The square pyramid from `apex` circumscribing the sphere of radius `radius` about `center`, traced
+    /// through its four corner (extremal) rays as Listing 4.2 does: the pyramid counterpart of
+    /// [`super::Cone::around_sphere`], bounding a point's shadow samples on a spherical light without looking
+    /// at them. The square's sides lie along [`Vec3::any_orthonormal_pair`] of the axis. Distances are depths
+    /// along the axis (at most the distance along a unit direction, so the walk stays conservative). `None`
+    /// where the cone proxy is `None`.
+    pub fn around_sphere(apex: Vec3, center: Vec3, radius: f32) -> Option<Self> {
+        let cone = super::Cone::around_sphere(apex, center, radius)?;
+        let (u, v) = cone.axis.any_orthonormal_pair();
+        let (u, v) = (u * cone.tan_alpha, v * cone.tan_alpha);
+        let corners = [u + v, u - v, -u + v, -u - v].map(|w| (cone.axis + w, cone.t_min, cone.t_max));
+        Self::bounding(apex, corners)
+    }
+
     /// The frustum of the valid rays of `packets[set]`, which must all start at `origin`, from the packets'
     /// inverse directions (no division per ray).
     #[inline(always)]

@@ -3,8 +3,8 @@
 //! Hard shadows go through the frame's traversal method as one tile of segments ending at the light (so the
 //! frustum methods trace them as frustums from the light, as the thesis does); the shadow cache and edge
 //! widths are single-ray techniques (DACRT, which traces sets, consults the cache for a whole layer at once);
-//! multi-sampling traces each point's samples as one bundle bounded by
-//! packets, a pyramid or a cone.
+//! multi-sampling traces each point's samples as one bundle: plain packets, a pyramid fitted to them, or a
+//! pyramid or cone around the light built before the samples ([`crate::trace::Proxy`]).
 
 use crate::ray::{Hit, Ray};
 use crate::scene::{PointLight, Scene};
@@ -120,16 +120,19 @@ impl ShadowTracer<'_> {
                     .zip(seeds)
                     .map(|(s, &seed)| {
                         let Some(s) = s else { return 0.0 };
-                        if to_center(s).is_none() {
-                            return 0.0;
-                        }
+                        let Some(apex) = to_center(s).map(|r| r.origin) else { return 0.0 };
                         sc.samples.generate(center, light.radius, s.point, samples, seed);
                         sc.rays.clear();
                         sc.rays.extend(sc.samples.points.iter().map(|&p| shadow_ray(s, center, p, eps)));
                         sc.blocked.clear();
                         sc.blocked.resize(sc.rays.len(), false);
-                        let (w, h) = (sc.samples.width as usize, sc.samples.height as usize);
-                        tracer.occluded_tile(&sc.rays, w, h, None, &mut sc.blocked, stats);
+                        let size = (sc.samples.width as usize, sc.samples.height as usize);
+                        match bound.proxy(apex, center, light.radius) {
+                            Some(proxy) => {
+                                self.tracer.occluded_in_proxy(&proxy, &sc.rays, size, &mut sc.blocked, stats)
+                            }
+                            None => tracer.occluded_tile(&sc.rays, size.0, size.1, None, &mut sc.blocked, stats),
+                        }
                         let lit = sc.rays.iter().zip(&sc.blocked).filter(|(r, b)| r.is_some() && !**b).count();
                         lit as f32 / sc.rays.len() as f32
                     })

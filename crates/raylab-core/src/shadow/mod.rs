@@ -17,42 +17,64 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use glam::Vec3;
+
 use crate::method::Method;
+use crate::packet::{Cone, Frustum};
+use crate::trace::Proxy;
 
 /// How the packets of a point's shadow samples are bounded when multi-sampling a spherical light (thesis
 /// Figure 4.5, Table 4.6).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SampleBound {
-    /// The samples are traced as plain 2x2 packets: the fastest here (a bundle of a few rays spread over a
-    /// wide light leaves most of its volume unsampled, and a frustum walks all of it; docs/BENCHMARKS.md).
+    /// The samples are traced as plain packets: the fastest here for 16 samples or fewer (a bundle of a
+    /// few rays spread over a wide light leaves most of its volume unsampled, and a frustum walks all of it;
+    /// docs/BENCHMARKS.md).
     #[default]
     Packets,
-    /// The samples of a point are bounded by one pyramid frustum.
+    /// One pyramid frustum fitted to the point's actual samples (Listing 4.2 over their rays): the tightest
+    /// per-axis bound, paid for with a pass over the rays.
+    Fitted,
+    /// The square pyramid circumscribing the light, seen from the point ([`Frustum::around_sphere`]): a
+    /// proxy built from the light alone, as the thesis's pyramid.
     Pyramid,
-    /// The samples of a point are bounded by one cone frustum, the shape of a spherical light's samples.
+    /// The cone tangent to the light, seen from the point ([`Cone::around_sphere`]): the thesis's cone
+    /// proxy, whose per-axis ranges are the sphere's own, narrower than any circumscribed square pyramid's.
     Cone,
 }
 
 impl SampleBound {
     /// All bounds, in menu order.
-    pub const ALL: [SampleBound; 3] = [SampleBound::Packets, SampleBound::Pyramid, SampleBound::Cone];
+    pub const ALL: [SampleBound; 4] =
+        [SampleBound::Packets, SampleBound::Fitted, SampleBound::Pyramid, SampleBound::Cone];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
         match self {
             SampleBound::Packets => "packets",
+            SampleBound::Fitted => "fitted",
             SampleBound::Pyramid => "pyramid",
             SampleBound::Cone => "cone",
         }
     }
 
-    /// The traversal method that traces one point's samples as a unit.
+    /// The proxy bounding every ray from `apex` to the light of radius `radius` about `center`, for the
+    /// bounds built from the light; `None` for the others, or where the apex is too close to the light.
+    pub fn proxy(self, apex: Vec3, center: Vec3, radius: f32) -> Option<Proxy> {
+        match self {
+            SampleBound::Pyramid => Frustum::around_sphere(apex, center, radius).map(Proxy::Pyramid),
+            SampleBound::Cone => Cone::around_sphere(apex, center, radius).map(Proxy::Cone),
+            SampleBound::Packets | SampleBound::Fitted => None,
+        }
+    }
+
+    /// The traversal method that traces one point's samples as a unit where there is no [`Self::proxy`]
+    /// (proxies fall back to packets).
     pub fn method(self) -> Method {
         match self {
-            SampleBound::Packets => Method::Packet,
-            SampleBound::Pyramid => Method::Frustum,
-            SampleBound::Cone => Method::Cone,
+            SampleBound::Fitted => Method::Frustum,
+            SampleBound::Packets | SampleBound::Pyramid | SampleBound::Cone => Method::Packet,
         }
     }
 }
@@ -64,7 +86,7 @@ impl FromStr for SampleBound {
         Self::ALL
             .into_iter()
             .find(|b| b.name() == s)
-            .ok_or_else(|| format!("unknown sample bound '{s}' (expected packets, pyramid or cone)"))
+            .ok_or_else(|| format!("unknown sample bound '{s}' (expected packets, fitted, pyramid or cone)"))
     }
 }
 

@@ -5,6 +5,10 @@
 //! the rays to share an origin (camera rays) or an end point (shadow rays toward a light, traced from the
 //! light as in the thesis); otherwise they fall back to packets, which is always exact.
 
+mod proxy;
+
+pub use proxy::Proxy;
+
 use glam::Vec3;
 use raylab_simd::{Backend, Kernel, VMask, Vf32};
 use serde::Serialize;

@@ -1,0 +1,92 @@
+//! Occlusion of ray bundles bounded by a proxy known before the rays: a cone or a pyramid around a spherical
+//! light, seen from the shaded point (Tsakok 2008, 4.1.6-4.1.9, Figure 4.5, Table 4.6).
+//!
+//! A frustum fitted to a bundle's rays costs a pass over them (the horizontal minima and maxima of Listing
+//! 4.2); a proxy is built from the light alone, in constant time, and the bundle walks the kd-tree as one
+//! interval whatever its rays are. The walk tests the bundle's packets at the leaves it reaches, so the
+//! answer is exact as long as every ray lies inside the proxy.
+
+use glam::Vec3;
+use raylab_simd::{Kernel, VMask, Vf32};
+
+use crate::method::Method;
+use crate::packet::{Cone, Frustum, PacketTile};
+use crate::ray::Ray;
+use crate::stats::TraversalStats;
+
+use super::Tracer;
+
+/// A bound on a bundle of rays from one point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Proxy {
+    /// A pyramid frustum, walked through its extremal rays' per-axis ranges (Listing 4.2).
+    Pyramid(Frustum),
+    /// A cone frustum (Listings 4.3-4.5).
+    Cone(Cone),
+}
+
+impl Proxy {
+    /// The apex every ray of the bundle must start at.
+    pub fn apex(&self) -> Vec3 {
+        match self {
+            Proxy::Pyramid(f) => f.origin,
+            Proxy::Cone(c) => c.origin,
+        }
+    }
+}
+
+impl Tracer<'_> {
+    /// Marks in `out` which rays of a `width x height` tile something blocks, walking the kd-tree once with
+    /// `proxy`, which must hold every ray's segment (all start at its apex). The brute-force reference
+    /// ([`Method::Reference`]) ignores the proxy and tests every ray alone, so the proxies are checked
+    /// against it.
+    pub fn occluded_in_proxy(
+        &self,
+        proxy: &Proxy,
+        rays: &[Option<Ray>],
+        (width, height): (usize, usize),
+        out: &mut [bool],
+        stats: &mut TraversalStats,
+    ) {
+        assert!(rays.len() == width * height && out.len() == rays.len());
+        if self.options.method == Method::Reference {
+            return self.occluded_tile(rays, width, height, None, out, stats);
+        }
+        raylab_simd::dispatch(
+            self.options.backend,
+            OccludedInProxy { tracer: self, proxy, rays, size: (width, height), out, stats },
+        );
+    }
+}
+
+/// [`Tracer::occluded_in_proxy`]'s walk as a [`Kernel`], so the backend picks the lane type.
+struct OccludedInProxy<'t, 'a> {
+    tracer: &'t Tracer<'a>,
+    proxy: &'t Proxy,
+    rays: &'t [Option<Ray>],
+    size: (usize, usize),
+    out: &'t mut [bool],
+    stats: &'t mut TraversalStats,
+}
+
+impl Kernel for OccludedInProxy<'_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Vf32>(self) {
+        let Self { tracer, proxy, rays, size: (width, height), out, stats } = self;
+        let tile = PacketTile::<V>::new(rays, width, height);
+        let all: Vec<usize> = (0..tile.packets.len()).filter(|&j| tile.packets[j].valid.any()).collect();
+        stats.rays += all.iter().map(|&j| tile.packets[j].valid.bits().count_ones() as u64).sum::<u64>();
+        stats.packets += all.len() as u64;
+        let mut blocked = vec![V::Mask::from_bits(0); tile.packets.len()];
+        let (tree, cull) = (tracer.tree, tracer.options.cull);
+        match proxy {
+            Proxy::Pyramid(f) => tree.occluded_frustum(f, &tile, &all, cull, &mut blocked, stats),
+            Proxy::Cone(c) => tree.occluded_frustum(c, &tile, &all, cull, &mut blocked, stats),
+        }
+        for (j, b) in blocked.iter().enumerate() {
+            let bits = b.bits();
+            tile.for_each_lane(j, |pixel, lane| out[pixel] = bits >> lane & 1 == 1);
+        }
+    }
+}
