@@ -1,12 +1,13 @@
-//! Bundles walked under a proxy built from a spherical light (the cone and the circumscribed pyramid of thesis
-//! 4.1.9) report the same occlusion as the brute-force reference for every ray toward the light: samples on
-//! the disc the renderer uses, points anywhere inside the sphere, lights of every size, lights inside
-//! geometry, and points right next to the light, on every built-in scene, SIMD backend and culling setting.
+//! Bundles walked under a proxy built from a spherical light's face (the cone and the circumscribed pyramid of
+//! thesis 4.1.9) report the same occlusion as the brute-force reference for every ray toward it: the
+//! renderer's stratified samples, points anywhere on the disc, apexes lifted off the point the disc faces,
+//! lights of every size, lights inside geometry, points right next to the light and far from the origin, on
+//! every built-in scene, SIMD backend and culling setting.
 
 use glam::Vec3;
 use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::method::Method;
-use raylab_core::packet::{Cone, Frustum};
+use raylab_core::packet::{Cone, Disc, Frustum};
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
 use raylab_core::scene::Scene;
@@ -26,12 +27,12 @@ impl Rng {
         (self.0 >> 40) as f32 / (1u64 << 24) as f32
     }
 
-    /// A point inside the unit ball.
-    fn in_ball(&mut self) -> Vec3 {
+    /// A point inside the unit disc.
+    fn in_disc(&mut self) -> (f32, f32) {
         loop {
-            let p = Vec3::new(self.next(), self.next(), self.next()) * 2.0 - Vec3::ONE;
-            if p.length_squared() <= 1.0 {
-                return p;
+            let (a, b) = (self.next() * 2.0 - 1.0, self.next() * 2.0 - 1.0);
+            if a * a + b * b <= 1.0 {
+                return (a, b);
             }
         }
     }
@@ -50,8 +51,8 @@ fn surface_points(scene: &Scene, tree: &KdTree, n: u32) -> Vec<Vec3> {
         .collect()
 }
 
-/// Checks both proxies of the light (`center`, `radius`) seen from `apex` on `targets` against brute force.
-fn check(tree: &KdTree, bf: &BruteForce, apex: Vec3, center: Vec3, radius: f32, targets: &[Vec3], what: &str) {
+/// Checks both proxies of `disc` seen from `apex` on `targets` against brute force.
+fn check(tree: &KdTree, bf: &BruteForce, apex: Vec3, disc: &Disc, targets: &[Vec3], what: &str) {
     let rays: Vec<Option<Ray>> = targets
         .iter()
         .map(|&p| {
@@ -62,10 +63,8 @@ fn check(tree: &KdTree, bf: &BruteForce, apex: Vec3, center: Vec3, radius: f32, 
         .collect();
     let mut stats = TraversalStats::default();
     let want: Vec<bool> = rays.iter().map(|r| r.is_some_and(|r| bf.occluded(&r, &mut stats))).collect();
-    let proxies = [
-        Frustum::around_sphere(apex, center, radius).map(Proxy::Pyramid),
-        Cone::around_sphere(apex, center, radius).map(Proxy::Cone),
-    ];
+    let proxies =
+        [Frustum::around_disc(apex, disc).map(Proxy::Pyramid), Cone::around_disc(apex, disc).map(Proxy::Cone)];
     for proxy in proxies.iter().flatten() {
         for backend in Backend::available() {
             for cull in [true, false] {
@@ -80,18 +79,28 @@ fn check(tree: &KdTree, bf: &BruteForce, apex: Vec3, center: Vec3, radius: f32, 
     }
 }
 
-/// Checks the proxies of each light seen from each of `apexes`, on its disc samples and on points in its volume.
-fn check_scene(scene: &Scene, apexes: &[Vec3], lights: &[(Vec3, f32)], what: &str) {
+/// Checks the proxies of each light seen from each of `points`, lifted off it a little as a shadow ray's
+/// origin is, on the light's stratified samples and on random points of its disc.
+fn check_scene(scene: &Scene, points: &[Vec3], lights: &[(Vec3, f32)], what: &str) {
     let tree = KdTree::build(scene, &KdParams::default()).unwrap();
     let bf = BruteForce::new(scene);
     let mut rng = Rng(0x5eed);
     let mut samples = LightSamples::default();
-    for (i, &apex) in apexes.iter().enumerate() {
+    for (i, &p) in points.iter().enumerate() {
+        let lift = Vec3::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5) * 2e-3;
+        let apex = p + lift;
         for &(center, radius) in lights {
-            samples.generate(center, radius, apex, 16, i as u32);
-            check(&tree, &bf, apex, center, radius, &samples.points, what);
-            let inside: Vec<Vec3> = (0..32).map(|_| center + rng.in_ball() * radius).collect();
-            check(&tree, &bf, apex, center, radius, &inside, what);
+            samples.generate(center, radius, p, 16, i as u32);
+            let disc = samples.disc;
+            check(&tree, &bf, apex, &disc, &samples.points, what);
+            let (u, v) = disc.normal.any_orthonormal_pair();
+            let on_disc: Vec<Vec3> = (0..32)
+                .map(|_| {
+                    let (a, b) = rng.in_disc();
+                    center + (u * a + v * b) * radius
+                })
+                .collect();
+            check(&tree, &bf, apex, &disc, &on_disc, what);
         }
     }
 }
@@ -114,15 +123,17 @@ fn proxies_hold_next_to_the_light_and_far_from_the_origin() {
     let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
     let bf = BruteForce::new(&scene);
     let center = scene.lights[0].position;
-    // Just outside the sphere the cone opens to its widest and then there is no proxy.
-    for gap in [1.0f32, 0.1, 0.01, 1e-4] {
-        let apex = center + Vec3::new(0.3, -1.0, 0.2).normalize() * (1.0 + gap);
-        let targets: Vec<Vec3> = (0..16).map(|k| center + Vec3::new((k % 4) as f32 - 1.5, 0.0, 0.0) * 0.5).collect();
-        check(&tree, &bf, apex, center, 1.0, &targets, &format!("gap {gap}"));
+    // Right in front of the light the proxies open to their widest, and then there are none.
+    let disc = Disc { center, normal: Vec3::new(0.3, 1.0, 0.2).normalize(), radius: 1.0 };
+    let (u, _) = disc.normal.any_orthonormal_pair();
+    let targets: Vec<Vec3> = (0..16).map(|k| center + u * ((k as f32 - 7.5) / 7.5)).collect();
+    for gap in [2.0f32, 0.5, 0.34, 0.1, 1e-4] {
+        check(&tree, &bf, center - disc.normal * gap, &disc, &targets, &format!("gap {gap}"));
     }
-    assert!(Cone::around_sphere(center, center, 1.0).is_none(), "an apex inside the light has no proxy");
-    assert!(Frustum::around_sphere(center + Vec3::X * 0.5, center, 1.0).is_none());
-    assert!(Cone::around_sphere(Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0), 1.0).is_none());
+    assert!(Cone::around_disc(center - disc.normal * 0.1, &disc).is_none(), "too wide");
+    assert!(Cone::around_disc(center, &disc).is_none(), "an apex on the disc has no proxy");
+    assert!(Frustum::around_disc(center + disc.normal, &disc).is_none(), "nor one behind it");
+    assert!(Cone::around_disc(Vec3::ZERO, &Disc { center: Vec3::NAN, ..disc }).is_none());
     // A scene shifted far from the origin: coordinates carry large absolute rounding errors.
     let shift = Vec3::new(1.0e5, -2.0e5, 3.0e5);
     let apexes: Vec<Vec3> = surface_points(&scene, &tree, 10).into_iter().map(|p| p + shift).collect();

@@ -15,7 +15,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{RayPacket, bundle_lanes, tile::Bundle, tile::Bundle4};
+use super::{Disc, RayPacket, bundle_lanes, tile::Bundle, tile::Bundle4};
 
 /// A cone bounding a bundle of rays from one origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,30 +63,16 @@ impl Cone {
         Some(Self::with_axis(origin, axis, pad_tan(tan_max), t_min.max(0.0), t_max))
     }
 
-    /// The cone from `apex` tangent to the sphere of radius `radius` about `center`: it holds every ray from
-    /// `apex` to a point of the sphere, so it bounds a point's shadow samples on a spherical light before
-    /// any of them is drawn (the cone proxy of thesis 4.1.9 and Figure 4.5). Depths run from 0 to the far
-    /// side of the sphere. `None` when `apex` is inside or near the sphere (the cone would open wider than
-    /// [`Cone::PROXY_MAX_TAN`]) or an input is not finite.
-    pub fn around_sphere(apex: Vec3, center: Vec3, radius: f32) -> Option<Self> {
-        let to = (center - apex).as_dvec3();
-        let d = to.length();
-        // Pad the radius for the rounding of sample points on the sphere (their coordinates carry an error
-        // relative to their size, not to the radius).
-        let r = radius.max(0.0) as f64 * (1.0 + 1e-5) + center.abs().max_element() as f64 * 1e-6;
-        if !(d.is_finite() && r.is_finite() && d > r) {
-            return None;
-        }
-        let tan = r / (d * d - r * r).sqrt();
-        if tan > Self::PROXY_MAX_TAN as f64 {
-            return None;
-        }
-        let axis = (to / d).as_vec3();
-        Some(Self::with_axis(apex, axis, pad_tan(tan), 0.0, ((d + r) * (1.0 + 1e-5)) as f32))
+    /// The cone from `apex` around `disc` (the face of a spherical light turned toward a shaded point, where
+    /// its samples lie): it holds every ray from `apex` to the disc, so it bounds the point's shadow samples
+    /// before any is drawn (the cone proxy of thesis 4.1.9 and Figure 4.5). Its axis is the disc's normal and
+    /// depths run from 0 to the disc. `None` when `apex` is not in front of the disc or too close to it (see
+    /// [`Disc::MAX_REACH`]).
+    pub fn around_disc(apex: Vec3, disc: &Disc) -> Option<Self> {
+        let span = disc.span_from(apex)?;
+        let tan = (span.center_dir - disc.normal.as_dvec3()).length() + span.reach;
+        Some(Self::with_axis(apex, disc.normal, pad_tan(tan), 0.0, span.depth))
     }
-
-    /// Widest cone [`Cone::around_sphere`] builds (tangent of the half-angle, about 72 degrees).
-    pub const PROXY_MAX_TAN: f32 = 3.0;
 
     /// The cone about unit `axis` with the per-axis precomputation of Listing 4.4.
     fn with_axis(origin: Vec3, axis: Vec3, tan_alpha: f32, t_min: f32, t_max: f32) -> Self {

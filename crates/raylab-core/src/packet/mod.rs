@@ -2,6 +2,7 @@
 //! 4.1.2; Listings 2.5-2.6 show the SoA layout).
 
 mod cone;
+mod disc;
 mod tile;
 mod woop;
 
@@ -11,6 +12,7 @@ use raylab_simd::{VMask, Vf32};
 use crate::ray::{Hit, Ray};
 
 pub use cone::{Cone, Cone4};
+pub use disc::Disc;
 pub use tile::{Bundle, Bundle4, Frustum, PacketTile, overlaps_box, slab_interval};
 pub use woop::{intersect_packet, occlude_packet};
 

@@ -4,7 +4,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{PacketHits, RayPacket};
+use super::{Disc, PacketHits, RayPacket};
 use crate::aabb::Aabb;
 use crate::ray::Ray;
 
@@ -239,18 +239,19 @@ impl Frustum {
         Some(f)
     }
 
-    /// The square pyramid from `apex` circumscribing the sphere of radius `radius` about `center`, traced
-    /// through its four corner (extremal) rays as Listing 4.2 does: the pyramid counterpart of
-    /// [`super::Cone::around_sphere`], bounding a point's shadow samples on a spherical light without looking
-    /// at them. The square's sides lie along [`Vec3::any_orthonormal_pair`] of the axis. Distances are depths
-    /// along the axis (at most the distance along a unit direction, so the walk stays conservative). `None`
-    /// where the cone proxy is `None`.
-    pub fn around_sphere(apex: Vec3, center: Vec3, radius: f32) -> Option<Self> {
-        let cone = super::Cone::around_sphere(apex, center, radius)?;
-        let (u, v) = cone.axis.any_orthonormal_pair();
-        let (u, v) = (u * cone.tan_alpha, v * cone.tan_alpha);
-        let corners = [u + v, u - v, -u + v, -u - v].map(|w| (cone.axis + w, cone.t_min, cone.t_max));
-        Self::bounding(apex, corners)
+    /// The square pyramid from `apex` around `disc` (the face of a spherical light turned toward a shaded
+    /// point), whose sides run along the axes of the samples' strata ([`Vec3::any_orthonormal_pair`] of the
+    /// normal): the pyramid counterpart of [`super::Cone::around_disc`], walked through its four corner
+    /// (extremal) rays as Listing 4.2 does. Distances are depths along the disc's normal (at most the distance
+    /// along a unit direction, so the walk stays conservative). `None` where the cone proxy is `None`.
+    pub fn around_disc(apex: Vec3, disc: &Disc) -> Option<Self> {
+        let span = disc.span_from(apex)?;
+        let (u, v) = disc.normal.any_orthonormal_pair();
+        // The corners' range on each axis: the centre direction plus or minus the reach along both sides.
+        let half = |k: usize| span.reach * (u[k].abs() as f64 + v[k].abs() as f64) + 1e-6;
+        let lo = Vec3::from_array(std::array::from_fn(|k| (span.center_dir[k] - half(k)) as f32));
+        let hi = Vec3::from_array(std::array::from_fn(|k| (span.center_dir[k] + half(k)) as f32));
+        Self::bounding(apex, [(lo, 0.0, span.depth), (hi, 0.0, span.depth)])
     }
 
     /// The frustum of the valid rays of `packets[set]`, which must all start at `origin`, from the packets'

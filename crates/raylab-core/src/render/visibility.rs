@@ -127,7 +127,7 @@ impl ShadowTracer<'_> {
                         sc.blocked.clear();
                         sc.blocked.resize(sc.rays.len(), false);
                         let size = (sc.samples.width as usize, sc.samples.height as usize);
-                        match bound.proxy(apex, center, light.radius) {
+                        match bound.proxy(apex, &sc.samples.disc) {
                             Some(proxy) => {
                                 self.tracer.occluded_in_proxy(&proxy, &sc.rays, size, &mut sc.blocked, stats)
                             }

@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use glam::Vec3;
 
 use crate::method::Method;
-use crate::packet::{Cone, Frustum};
+use crate::packet::{Cone, Disc, Frustum};
 use crate::trace::Proxy;
 
 /// How the packets of a point's shadow samples are bounded when multi-sampling a spherical light (thesis
@@ -36,11 +36,11 @@ pub enum SampleBound {
     /// One pyramid frustum fitted to the point's actual samples (Listing 4.2 over their rays): the tightest
     /// per-axis bound, paid for with a pass over the rays.
     Fitted,
-    /// The square pyramid circumscribing the light, seen from the point ([`Frustum::around_sphere`]): a
-    /// proxy built from the light alone, as the thesis's pyramid.
+    /// The square pyramid around the light's face seen from the point ([`Frustum::around_disc`]): a proxy
+    /// built from the light alone, as the thesis's pyramid.
     Pyramid,
-    /// The cone tangent to the light, seen from the point ([`Cone::around_sphere`]): the thesis's cone
-    /// proxy, whose per-axis ranges are the sphere's own, narrower than any circumscribed square pyramid's.
+    /// The cone around the light's face seen from the point ([`Cone::around_disc`]): the thesis's cone proxy,
+    /// whose per-axis ranges are the disc's own, narrower than a circumscribed square pyramid's.
     Cone,
 }
 
@@ -59,12 +59,12 @@ impl SampleBound {
         }
     }
 
-    /// The proxy bounding every ray from `apex` to the light of radius `radius` about `center`, for the
-    /// bounds built from the light; `None` for the others, or where the apex is too close to the light.
-    pub fn proxy(self, apex: Vec3, center: Vec3, radius: f32) -> Option<Proxy> {
+    /// The proxy bounding every ray from `apex` to `disc` (where a point's samples lie), for the bounds built
+    /// from the light; `None` for the others, or where the apex is too close to the light.
+    pub fn proxy(self, apex: Vec3, disc: &Disc) -> Option<Proxy> {
         match self {
-            SampleBound::Pyramid => Frustum::around_sphere(apex, center, radius).map(Proxy::Pyramid),
-            SampleBound::Cone => Cone::around_sphere(apex, center, radius).map(Proxy::Cone),
+            SampleBound::Pyramid => Frustum::around_disc(apex, disc).map(Proxy::Pyramid),
+            SampleBound::Cone => Cone::around_disc(apex, disc).map(Proxy::Cone),
             SampleBound::Packets | SampleBound::Fitted => None,
         }
     }

@@ -7,6 +7,8 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::packet::Disc;
+
 /// The `gx x gy` grid of `n` strata: the most square factorisation with `gx >= gy` (4 -> 2x2, 8 -> 4x2,
 /// 16 -> 4x4, 32 -> 8x4).
 pub fn stratified_grid(n: u32) -> (u32, u32) {
@@ -27,6 +29,8 @@ pub struct LightSamples {
     pub height: u32,
     /// The sample positions, row-major.
     pub points: Vec<Vec3>,
+    /// The disc they lie on: the light's face turned toward the shaded point.
+    pub disc: Disc,
 }
 
 impl LightSamples {
@@ -37,7 +41,9 @@ impl LightSamples {
         (self.width, self.height) = (gx, gy);
         self.points.clear();
         let axis = (center - from).normalize_or_zero();
-        let (u, v) = if axis == Vec3::ZERO { (Vec3::X, Vec3::Y) } else { axis.any_orthonormal_pair() };
+        let axis = if axis == Vec3::ZERO { Vec3::Z } else { axis };
+        let (u, v) = axis.any_orthonormal_pair();
+        self.disc = Disc { center, normal: axis, radius };
         for j in 0..gy {
             for i in 0..gx {
                 let k = j * gx + i;
