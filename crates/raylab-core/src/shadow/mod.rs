@@ -59,6 +59,16 @@ impl SampleBound {
         }
     }
 
+    /// A one-line description for menus.
+    pub fn summary(self) -> &'static str {
+        match self {
+            SampleBound::Packets => "each packet of samples walks the tree alone",
+            SampleBound::Fitted => "one pyramid fitted to the point's samples (a pass over them)",
+            SampleBound::Pyramid => "the square pyramid around the light, built before the samples",
+            SampleBound::Cone => "the cone around the light, built before the samples",
+        }
+    }
+
     /// The proxy bounding every ray from `apex` to `disc` (where a point's samples lie), for the bounds built
     /// from the light; `None` for the others, or where the apex is too close to the light.
     pub fn proxy(self, apex: Vec3, disc: &Disc) -> Option<Proxy> {

@@ -293,7 +293,7 @@ fn shadow_controls(ui: &mut egui::Ui, s: &mut ViewerSettings, light_radius: f32)
         Shadows::MultiSample { bound, .. } => {
             egui::ComboBox::from_label("sample bound").selected_text(bound.name()).show_ui(ui, |ui| {
                 for b in SampleBound::ALL {
-                    ui.selectable_value(bound, b, b.name());
+                    ui.selectable_value(bound, b, b.name()).on_hover_text(b.summary());
                 }
             });
             ui.small(format!("light radius {light_radius}"));
