@@ -4,7 +4,8 @@
 
 use std::time::Instant;
 
-use raylab_core::ray::Ray;
+use glam::Vec3;
+use raylab_core::ray::{Hit, Ray};
 use raylab_core::reference::BruteForce;
 use raylab_core::stats::TraversalStats;
 use raylab_core::trace::Tracer;
@@ -77,58 +78,96 @@ pub struct TraceReport {
     pub culled_percent: f64,
 }
 
-/// Traces every ray of `w` once, on the current rayon pool, in `tile x tile` tiles taken by the threads.
-pub fn trace_once(tracer: &Tracer, w: &Workload, tile: u32) -> (Vec<PixelResult>, TraversalStats) {
-    let (width, height) = (w.width as usize, w.height as usize);
-    let tile = tile as usize;
-    let tiles: Vec<(usize, usize)> = (0..height.div_ceil(tile))
-        .flat_map(|ty| (0..width.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile)))
-        .collect();
-    let occlusion = w.kind.is_occlusion();
-    let parts: Vec<TileOutput> = tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let mut stats = TraversalStats::default();
-            let (tw, th) = (tile.min(width - x0), tile.min(height - y0));
-            let rays: Vec<Option<Ray>> = (y0..y0 + th)
-                .flat_map(|y| (x0..x0 + tw).map(move |x| (x, y)))
-                .map(|(x, y)| w.rays[y * width + x])
-                .collect();
-            let results = if occlusion {
-                let mut out = vec![false; rays.len()];
-                tracer.occluded_tile(&rays, tw, th, w.toward, &mut out, &mut stats);
-                rays.iter()
-                    .zip(out)
-                    .map(|(r, o)| if r.is_some() { PixelResult::Occluded(o) } else { PixelResult::None })
-                    .collect()
-            } else {
-                let mut out = vec![None; rays.len()];
-                tracer.intersect_tile(&rays, tw, th, &mut out, &mut stats);
-                rays.iter()
-                    .zip(out)
-                    .map(
-                        |(r, h)| {
-                            if r.is_some() { PixelResult::Hit(h.map(|h| (h.t, h.tri))) } else { PixelResult::None }
-                        },
-                    )
-                    .collect()
-            };
-            ((x0, y0, tw, th), results, stats)
-        })
-        .collect();
-    let mut results = vec![PixelResult::None; w.rays.len()];
-    let mut stats = TraversalStats::default();
-    for ((x0, y0, tw, _), part, s) in parts {
-        for (i, r) in part.into_iter().enumerate() {
-            results[(y0 + i / tw) * width + x0 + i % tw] = r;
-        }
-        stats += s;
-    }
-    (results, stats)
+/// One tile of a [`TiledWorkload`]: its rectangle, its rays row by row, its output buffers and counters.
+struct TileJob {
+    x0: usize,
+    y0: usize,
+    width: usize,
+    height: usize,
+    rays: Vec<Option<Ray>>,
+    hits: Vec<Option<Hit>>,
+    occluded: Vec<bool>,
+    stats: TraversalStats,
 }
 
-/// A traced tile: its rectangle, per-pixel results and counters.
-type TileOutput = ((usize, usize, usize, usize), Vec<PixelResult>, TraversalStats);
+/// A workload cut into `tile x tile` tiles before any timing, as the harness prepares its rays: each tile owns
+/// its rays and its output buffers, so a timed run does nothing but trace (the threads of the current rayon
+/// pool take the tiles), and putting the results back in image order happens after the clock stops.
+pub struct TiledWorkload {
+    tiles: Vec<TileJob>,
+    width: usize,
+    pixels: usize,
+    occlusion: bool,
+    toward: Option<Vec3>,
+}
+
+impl TiledWorkload {
+    /// Cuts `w` into tiles of edge `tile` (smaller at the image's right and bottom edges).
+    pub fn new(w: &Workload, tile: u32) -> Self {
+        let (width, height) = (w.width as usize, w.height as usize);
+        let tile = tile.max(1) as usize;
+        let tiles = (0..height.div_ceil(tile))
+            .flat_map(|ty| (0..width.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile)))
+            .map(|(x0, y0)| {
+                let (tw, th) = (tile.min(width - x0), tile.min(height - y0));
+                let rays: Vec<Option<Ray>> =
+                    (y0..y0 + th).flat_map(|y| w.rays[y * width + x0..y * width + x0 + tw].iter().copied()).collect();
+                let n = rays.len();
+                TileJob {
+                    x0,
+                    y0,
+                    width: tw,
+                    height: th,
+                    rays,
+                    hits: vec![None; n],
+                    occluded: vec![false; n],
+                    stats: TraversalStats::default(),
+                }
+            })
+            .collect();
+        Self { tiles, width, pixels: w.rays.len(), occlusion: w.kind.is_occlusion(), toward: w.toward }
+    }
+
+    /// Traces every tile once with `tracer` on the current rayon pool: the timed part of a run.
+    pub fn trace(&mut self, tracer: &Tracer) {
+        let (occlusion, toward) = (self.occlusion, self.toward);
+        self.tiles.par_iter_mut().for_each(|t| {
+            t.stats = TraversalStats::default();
+            if occlusion {
+                tracer.occluded_tile(&t.rays, t.width, t.height, toward, &mut t.occluded, &mut t.stats);
+            } else {
+                tracer.intersect_tile(&t.rays, t.width, t.height, &mut t.hits, &mut t.stats);
+            }
+        });
+    }
+
+    /// The last trace's per-pixel results in image order, and its counters summed over the tiles.
+    pub fn results(&self) -> (Vec<PixelResult>, TraversalStats) {
+        let mut results = vec![PixelResult::None; self.pixels];
+        let mut stats = TraversalStats::default();
+        for t in &self.tiles {
+            for (i, r) in t.rays.iter().enumerate() {
+                if r.is_none() {
+                    continue;
+                }
+                results[(t.y0 + i / t.width) * self.width + t.x0 + i % t.width] = if self.occlusion {
+                    PixelResult::Occluded(t.occluded[i])
+                } else {
+                    PixelResult::Hit(t.hits[i].map(|h| (h.t, h.tri)))
+                };
+            }
+            stats += t.stats;
+        }
+        (results, stats)
+    }
+}
+
+/// Traces every ray of `w` once, on the current rayon pool, in `tile x tile` tiles taken by the threads.
+pub fn trace_once(tracer: &Tracer, w: &Workload, tile: u32) -> (Vec<PixelResult>, TraversalStats) {
+    let mut tiled = TiledWorkload::new(w, tile);
+    tiled.trace(tracer);
+    tiled.results()
+}
 
 /// Runs `warmup` untimed and `reps` timed traces of `w` on a pool of `threads` threads.
 pub fn measure(
@@ -144,21 +183,20 @@ pub fn measure(
         .build()
         .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
     let rays = w.ray_count();
-    let mut last = None;
+    let mut tiled = TiledWorkload::new(w, tile);
     let mut speeds = Vec::with_capacity(reps);
     pool.install(|| {
         for _ in 0..warmup {
-            last = Some(trace_once(tracer, w, tile));
+            tiled.trace(tracer);
         }
         for _ in 0..reps.max(1) {
             let t0 = Instant::now();
-            let r = trace_once(tracer, w, tile);
+            tiled.trace(tracer);
             let secs = t0.elapsed().as_secs_f64();
             speeds.push(rays as f64 / secs.max(1e-12) / 1e6);
-            last = Some(r);
         }
     });
-    let (results, stats) = last.expect("at least one run");
+    let (results, stats) = tiled.results();
     speeds.sort_by(f64::total_cmp);
     let (hits, sum_t) = summarize(&results);
     let report = TraceReport {

@@ -100,6 +100,27 @@ fn dacrt_matches_brute_force_on_every_builtin_scene() {
     }
 }
 
+/// Sets smaller than [`raylab_core::dacrt::FORK_BELOW`] are traced against the two triangle groups on two
+/// threads when the pool has them, on one thread otherwise: each way gives the reference's answers, and each
+/// ray is counted once.
+#[test]
+fn small_sets_give_the_same_hits_forked_and_on_one_thread() {
+    let scene = builtin::build("kitchen", Detail::Test).unwrap();
+    let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let mut rays = adversarial_rays(&scene, &kd, 100, 7);
+    rays.extend(incoherent(&scene, 1200, 23));
+    assert!(rays.len() < raylab_core::dacrt::FORK_BELOW);
+    let d = Dacrt::new(&scene);
+    for threads in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let what = format!("{threads} threads");
+        let s = pool.install(|| check_sets(&scene, &d, &DacrtParams::default(), &rays, rays.len(), &what));
+        assert_eq!(s.rays, 3 * rays.len() as u64, "{what}");
+        let singles = pool.install(|| check_sets(&scene, &d, &DacrtParams::default(), &rays[..40], 1, &what));
+        assert_eq!(singles.rays, 3 * 40, "{what}");
+    }
+}
+
 #[test]
 fn every_split_rule_and_leaf_threshold_gives_the_same_hits() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();

@@ -16,6 +16,7 @@ mod traverse;
 
 pub use split::SplitRule;
 
+use std::ops::Range;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -51,6 +52,19 @@ impl DacrtParams {
     pub const MAX_LEAF: usize = 4096;
 }
 
+/// Ray sets with fewer rays than this are traced against the two [`Dacrt`] triangle groups on two threads
+/// when the rayon pool has them (the hybrid mode's reflection and shadow rays, a few thousand a frame): each
+/// thread then divides half of the triangles. Larger sets stay on one thread, where testing the nearer group
+/// first shortens the rays before the farther one, and the renderers trace several such sets at once.
+pub const FORK_BELOW: usize = 16384;
+
+/// Triangles `tris` of [`Dacrt`]'s references, bounded by `bounds`.
+#[derive(Clone, Debug)]
+struct Group {
+    tris: Range<usize>,
+    bounds: SetBounds,
+}
+
 /// Per-call working memory: the triangle references (a permutation of the scene's, reused from call to call),
 /// the moved rays and the filter's flags.
 struct Scratch {
@@ -64,6 +78,10 @@ pub struct Dacrt {
     soup: TriangleSoup,
     refs: Vec<TriRecord>,
     root: SetBounds,
+    /// The triangles divided once, at setup, into two groups of `refs` (the division every call would make
+    /// first), so that a small ray set can be traced against each group on its own thread
+    /// ([`FORK_BELOW`]); `None` for fewer than two triangles.
+    groups: Option<[Group; 2]>,
     setup_time: Duration,
     /// Working memory of finished calls, reused by the next ones (one per thread that traced).
     pool: Mutex<Vec<Scratch>>,
@@ -76,10 +94,20 @@ impl Dacrt {
     pub fn new(scene: &Scene) -> Self {
         let start = Instant::now();
         let soup = TriangleSoup::from_scene(scene);
-        let refs: Vec<TriRecord> =
+        let mut refs: Vec<TriRecord> =
             soup.as_slice().iter().enumerate().map(|(i, t)| TriRecord::new(*t, i as u32)).collect();
         let root = SetBounds::of(&refs);
-        Self { soup, refs, root, setup_time: start.elapsed(), pool: Mutex::new(Vec::new()), backend: Backend::detect() }
+        let groups = split::divide(&mut refs, &root, SplitRule::Sah, &mut Vec::new())
+            .map(|s| [Group { tris: 0..s.mid, bounds: s.first }, Group { tris: s.mid..refs.len(), bounds: s.second }]);
+        Self {
+            soup,
+            refs,
+            root,
+            groups,
+            setup_time: start.elapsed(),
+            pool: Mutex::new(Vec::new()),
+            backend: Backend::detect(),
+        }
     }
 
     /// How long [`Dacrt::new`] took.
@@ -103,14 +131,32 @@ impl Dacrt {
     ) {
         assert_eq!(rays.len(), out.len());
         out.fill(None);
-        self.run(p, rays, Closest { out }, stats);
+        let Some(groups) = self.fork(rays.len()) else {
+            return self.run(p, rays, self.whole(), Closest { out }, stats);
+        };
+        let mut second = vec![None; rays.len()];
+        self.run_forked(p, rays, groups, [Closest { out: &mut *out }, Closest { out: &mut second }], stats);
+        for (o, s) in out.iter_mut().zip(second) {
+            if let Some(s) = s
+                && o.is_none_or(|o| s.t < o.t || (s.t == o.t && s.tri < o.tri))
+            {
+                *o = Some(s);
+            }
+        }
     }
 
     /// Whether anything blocks each of `rays` in `(tmin, tmax]`, written to `out`.
     pub fn occluded(&self, p: &DacrtParams, rays: &[Option<Ray>], out: &mut [bool], stats: &mut TraversalStats) {
         assert_eq!(rays.len(), out.len());
         out.fill(false);
-        self.run(p, rays, Any { out }, stats);
+        let Some(groups) = self.fork(rays.len()) else {
+            return self.run(p, rays, self.whole(), Any { out }, stats);
+        };
+        let mut second = vec![false; rays.len()];
+        self.run_forked(p, rays, groups, [Any { out: &mut *out }, Any { out: &mut second }], stats);
+        for (o, s) in out.iter_mut().zip(second) {
+            *o |= s;
+        }
     }
 
     /// The first blocker found along each of `rays` (not necessarily the nearest), for the shadow cache.
@@ -123,7 +169,14 @@ impl Dacrt {
     ) {
         assert_eq!(rays.len(), out.len());
         out.fill(None);
-        self.run(p, rays, Blocker { out }, stats);
+        let Some(groups) = self.fork(rays.len()) else {
+            return self.run(p, rays, self.whole(), Blocker { out }, stats);
+        };
+        let mut second = vec![None; rays.len()];
+        self.run_forked(p, rays, groups, [Blocker { out: &mut *out }, Blocker { out: &mut second }], stats);
+        for (o, s) in out.iter_mut().zip(second) {
+            *o = o.or(s);
+        }
     }
 
     /// True when triangle `tri` blocks `ray`.
@@ -133,7 +186,49 @@ impl Dacrt {
             && crate::triangle::RayShear::new(ray).intersect(self.soup.get(tri), ray.tmin, ray.tmax).is_some()
     }
 
-    fn run<A: Answer>(&self, p: &DacrtParams, rays: &[Option<Ray>], answer: A, stats: &mut TraversalStats) {
+    /// The groups to trace a set of `rays` rays against on two threads, when the current rayon pool has them
+    /// and the set is small enough that dividing the triangles, not the rays' own work, is most of its cost.
+    fn fork(&self, rays: usize) -> Option<&[Group; 2]> {
+        (rays < FORK_BELOW && rayon::current_num_threads() > 1).then_some(())?;
+        self.groups.as_ref()
+    }
+
+    /// All triangles as one group.
+    fn whole(&self) -> Group {
+        Group { tris: 0..self.refs.len(), bounds: self.root }
+    }
+
+    /// Traces `rays` against each of the two `groups` on its own thread, each answer into its own output;
+    /// the callers merge the outputs.
+    fn run_forked<A: Answer + Send>(
+        &self,
+        p: &DacrtParams,
+        rays: &[Option<Ray>],
+        groups: &[Group; 2],
+        [first, second]: [A; 2],
+        stats: &mut TraversalStats,
+    ) {
+        let (mut a, mut b) = (TraversalStats::default(), TraversalStats::default());
+        rayon::join(
+            || self.run(p, rays, groups[0].clone(), first, &mut a),
+            || self.run(p, rays, groups[1].clone(), second, &mut b),
+        );
+        // Each ray was counted by both groups.
+        b.rays = 0;
+        b.packets = 0;
+        *stats += a;
+        *stats += b;
+    }
+
+    /// Traces `rays` against the triangles of `group`.
+    fn run<A: Answer>(
+        &self,
+        p: &DacrtParams,
+        rays: &[Option<Ray>],
+        group: Group,
+        answer: A,
+        stats: &mut TraversalStats,
+    ) {
         let mut scratch = self.take_scratch();
         scratch.rays.clear();
         scratch.rays.extend(
@@ -141,7 +236,7 @@ impl Dacrt {
         );
         stats.rays += scratch.rays.len() as u64;
         stats.packets += scratch.rays.len() as u64;
-        if !scratch.rays.is_empty() && !self.refs.is_empty() {
+        if !scratch.rays.is_empty() && !group.tris.is_empty() {
             let mut walk = Walk {
                 soup: &self.soup,
                 params: *p,
@@ -150,21 +245,17 @@ impl Dacrt {
                 backend: self.backend,
                 stats: TraversalStats::default(),
             };
-            self.start(&mut walk, &mut scratch);
+            let Scratch { tris, rays, .. } = &mut scratch;
+            walk.stats.box_tests += rays.len() as u64;
+            let filter_box = filter::FilterBox::new(&group.bounds.bounds);
+            let k = filter::filter(walk.backend, rays, &filter_box, &mut walk.flags);
+            if k > 0 {
+                walk.recurse(&mut rays[..k], &mut tris[group.tris], group.bounds, 0);
+            }
             scratch.flags = walk.flags;
             *stats += walk.stats;
         }
         self.pool.lock().unwrap_or_else(|e| e.into_inner()).push(scratch);
-    }
-
-    /// Filters the rays against the scene's box, then recurses.
-    fn start<A: Answer>(&self, walk: &mut Walk<A>, scratch: &mut Scratch) {
-        let Scratch { tris, rays, .. } = scratch;
-        walk.stats.box_tests += rays.len() as u64;
-        let k = filter::filter(walk.backend, rays, &filter::FilterBox::new(&self.root.bounds), &mut walk.flags);
-        if k > 0 {
-            walk.recurse(&mut rays[..k], tris, self.root, 0);
-        }
     }
 
     fn take_scratch(&self) -> Scratch {

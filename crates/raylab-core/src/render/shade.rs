@@ -7,6 +7,8 @@
 //! The secondary directions and weights (mirror reflection, refraction, Schlick's Fresnel, Beer's law) are
 //! here too; the renderer traces them.
 
+use std::sync::LazyLock;
+
 use glam::{Vec2, Vec3};
 
 use crate::ray::{Hit, Ray};
@@ -185,14 +187,86 @@ pub fn normal_mapped(scene: &Scene, tri: usize, n: Vec3, texel: Vec3) -> Vec3 {
     if bent == Vec3::ZERO { n } else { bent }
 }
 
-/// Linear value to an 8-bit display value with the harness's gamma of 2.2.
+/// Linear value to an 8-bit display value with the harness's gamma of 2.2: `round(255 v^(1/2.2))` of `v`
+/// clamped to `[0, 1]`, NaN to 0. Every pixel of every frame goes through this, so instead of a `powf` it
+/// looks up the byte at the start of `v`'s bucket and steps past the display steps `v` has reached (at most
+/// one above 0.004), which gives exactly the formula's byte.
+#[inline]
 pub fn to_display(v: f32) -> u8 {
+    if v.is_nan() || v <= 0.0 {
+        return 0;
+    }
+    if v >= 1.0 {
+        return 255;
+    }
+    let table = &*DISPLAY;
+    // `v * BUCKETS` is exact (a power of two), so the bucket's lower edge is at or below `v`.
+    let mut byte = table.bucket_start[(v * DisplayTable::BUCKETS as f32) as usize] as usize;
+    while v >= table.steps[byte] {
+        byte += 1;
+    }
+    byte as u8
+}
+
+/// The display formula itself, which [`DisplayTable`] is derived from.
+fn gamma_byte(v: f32) -> u8 {
     (255.0 * v.clamp(0.0, 1.0).powf(1.0 / 2.2)).round() as u8
 }
+
+/// Where [`gamma_byte`] steps up on `[0, 1]` (it never decreases there), for [`to_display`].
+struct DisplayTable {
+    /// Entry `k` is the smallest value that [`gamma_byte`] takes to `k + 1` or more; the last is infinite.
+    steps: [f32; 256],
+    /// The byte of each bucket's lower edge, `b / BUCKETS`.
+    bucket_start: [u8; DisplayTable::BUCKETS],
+}
+
+impl DisplayTable {
+    /// Equal-width buckets of `[0, 1)`.
+    const BUCKETS: usize = 4096;
+
+    fn new() -> Self {
+        let steps = std::array::from_fn(|k| {
+            if k == 255 {
+                return f32::INFINITY;
+            }
+            // Non-negative floats order like their bit patterns: bisect the patterns of [0, 1].
+            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if gamma_byte(f32::from_bits(mid)) as usize > k { hi = mid } else { lo = mid + 1 }
+            }
+            f32::from_bits(lo)
+        });
+        let bucket_start = std::array::from_fn(|b| gamma_byte(b as f32 / Self::BUCKETS as f32));
+        Self { steps, bucket_start }
+    }
+}
+
+static DISPLAY: LazyLock<DisplayTable> = LazyLock::new(DisplayTable::new);
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The step search gives the formula's byte: at and just below every step, across `[0, 1]` at a stride
+    /// of bit patterns, and for values outside it.
+    #[test]
+    fn display_bytes_match_the_gamma_formula() {
+        for (k, &step) in DISPLAY.steps[..255].iter().enumerate() {
+            assert_eq!(to_display(step), gamma_byte(step), "step {}", k + 1);
+            assert_eq!(gamma_byte(step) as usize, k + 1, "step {} is reached", k + 1);
+            let below = f32::from_bits(step.to_bits() - 1);
+            assert_eq!(to_display(below), gamma_byte(below), "below step {}", k + 1);
+        }
+        for bits in (0..=1.0f32.to_bits()).step_by(4099) {
+            let v = f32::from_bits(bits);
+            assert_eq!(to_display(v), gamma_byte(v), "{v}");
+        }
+        for v in [-1.0, -0.0, 0.0, 1.0, 1.5, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, f32::MIN_POSITIVE] {
+            assert_eq!(to_display(v), gamma_byte(v), "{v}");
+        }
+    }
 
     /// One triangle in the z = 0 plane facing +z, u along +x and v along +y, with a 2x1 diffuse texture
     /// (red, green) and a normal map.

@@ -81,20 +81,18 @@ impl TileContext<'_> {
                 _ => Vec3::ZERO,
             })
             .collect();
-        let spawn = depth < self.settings.max_depth;
-        let n = rays.len();
-        let mut mixes = vec![Mix { local: 1.0, ..Mix::default() }; n];
-        let (mut refl, mut refr) = (Branch::new(n), Branch::new(n));
+        let spawn = depth < self.settings.max_depth
+            && surfaces.iter().flatten().any(|s| s.material.kind.reflects() || s.material.kind.refracts());
         if spawn {
+            let n = rays.len();
+            let mut mixes = vec![Mix { local: 1.0, ..Mix::default() }; n];
+            let (mut refl, mut refr) = (Branch::new(n), Branch::new(n));
             for i in 0..n {
                 if let (Some(s), Some(r)) = (&surfaces[i], &rays[i]) {
                     mixes[i] = self.spawn(s, r, seeds[i], i, &mut refl, &mut refr);
                 }
             }
-        }
-        shading += t1.elapsed().as_secs_f64();
-
-        if spawn {
+            shading += t1.elapsed().as_secs_f64();
             let reflected = self.trace_branch(&refl, dims, depth + 1, out, sc);
             let refracted = self.trace_branch(&refr, dims, depth + 1, out, sc);
             let t = Instant::now();
@@ -104,6 +102,8 @@ impl TileContext<'_> {
                 *c = *c * m.local + r * m.reflect + t * m.refract;
             }
             shading += t.elapsed().as_secs_f64();
+        } else {
+            shading += t1.elapsed().as_secs_f64();
         }
         if depth == 0 {
             out.stages.shading += shading;
