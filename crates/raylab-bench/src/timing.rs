@@ -78,7 +78,8 @@ pub struct TraceReport {
     pub culled_percent: f64,
 }
 
-/// One tile of a [`TiledWorkload`]: its rectangle, its rays row by row, its output buffers and counters.
+/// One tile of a [`TiledWorkload`]: its rectangle, its rays row by row, its output buffer (closest hits or
+/// occlusion, after the workload's kind; the other stays empty) and counters.
 struct TileJob {
     x0: usize,
     y0: usize,
@@ -106,6 +107,7 @@ impl TiledWorkload {
     pub fn new(w: &Workload, tile: u32) -> Self {
         let (width, height) = (w.width as usize, w.height as usize);
         let tile = tile.max(1) as usize;
+        let occlusion = w.kind.is_occlusion();
         let tiles = (0..height.div_ceil(tile))
             .flat_map(|ty| (0..width.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile)))
             .map(|(x0, y0)| {
@@ -119,13 +121,13 @@ impl TiledWorkload {
                     width: tw,
                     height: th,
                     rays,
-                    hits: vec![None; n],
-                    occluded: vec![false; n],
+                    hits: if occlusion { Vec::new() } else { vec![None; n] },
+                    occluded: if occlusion { vec![false; n] } else { Vec::new() },
                     stats: TraversalStats::default(),
                 }
             })
             .collect();
-        Self { tiles, width, pixels: w.rays.len(), occlusion: w.kind.is_occlusion(), toward: w.toward }
+        Self { tiles, width, pixels: w.rays.len(), occlusion, toward: w.toward }
     }
 
     /// Traces every tile once with `tracer` on the current rayon pool: the timed part of a run.

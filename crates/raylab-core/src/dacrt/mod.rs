@@ -28,7 +28,7 @@ use crate::scene::Scene;
 use crate::stats::TraversalStats;
 use crate::triangle::TriangleSoup;
 use records::{RayRecord, SetBounds, TriRecord};
-use traverse::{Answer, Any, Blocker, Closest, Walk};
+use traverse::{Answer, Any, Blocker, Closest, Walk, beats};
 
 /// When DACRT stops dividing and how it divides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -138,7 +138,7 @@ impl Dacrt {
         self.run_forked(p, rays, groups, [Closest { out: &mut *out }, Closest { out: &mut second }], stats);
         for (o, s) in out.iter_mut().zip(second) {
             if let Some(s) = s
-                && o.is_none_or(|o| s.t < o.t || (s.t == o.t && s.tri < o.tri))
+                && beats(&s, *o)
             {
                 *o = Some(s);
             }

@@ -56,6 +56,13 @@ impl<A: Answer> Kernel for LeafKernel<'_, A> {
     }
 }
 
+/// True when `h` is to replace `best` as a ray's closest hit: it is nearer, or as near with a lower triangle
+/// id, as in the brute-force reference.
+#[inline(always)]
+pub(super) fn beats(h: &Hit, best: Option<Hit>) -> bool {
+    best.is_none_or(|b| h.t < b.t || (h.t == b.t && h.tri < b.tri))
+}
+
 /// Closest hits, written at each ray's id.
 pub(super) struct Closest<'a> {
     pub out: &'a mut [Option<Hit>],
@@ -74,8 +81,7 @@ impl Answer for Closest<'_> {
             for (r, h) in group.iter_mut().zip(found) {
                 let Some(h) = h else { continue };
                 let best = &mut self.out[r.id as usize];
-                // Equal distances go to the lower triangle id, as in the brute-force reference.
-                if best.is_none_or(|b| h.t < b.t || h.tri < b.tri) {
+                if beats(&h, *best) {
                     *best = Some(h);
                     r.tmax = h.t;
                 }

@@ -83,7 +83,7 @@ impl TileContext<'_> {
             .collect();
         let spawn = depth < self.settings.max_depth
             && surfaces.iter().flatten().any(|s| s.material.kind.reflects() || s.material.kind.refracts());
-        if spawn {
+        let secondary = spawn.then(|| {
             let n = rays.len();
             let mut mixes = vec![Mix { local: 1.0, ..Mix::default() }; n];
             let (mut refl, mut refr) = (Branch::new(n), Branch::new(n));
@@ -92,7 +92,11 @@ impl TileContext<'_> {
                     mixes[i] = self.spawn(s, r, seeds[i], i, &mut refl, &mut refr);
                 }
             }
-            shading += t1.elapsed().as_secs_f64();
+            (mixes, refl, refr)
+        });
+        shading += t1.elapsed().as_secs_f64();
+
+        if let Some((mixes, refl, refr)) = secondary {
             let reflected = self.trace_branch(&refl, dims, depth + 1, out, sc);
             let refracted = self.trace_branch(&refr, dims, depth + 1, out, sc);
             let t = Instant::now();
@@ -102,8 +106,6 @@ impl TileContext<'_> {
                 *c = *c * m.local + r * m.reflect + t * m.refract;
             }
             shading += t.elapsed().as_secs_f64();
-        } else {
-            shading += t1.elapsed().as_secs_f64();
         }
         if depth == 0 {
             out.stages.shading += shading;
