@@ -171,14 +171,15 @@ pub fn trace_once(tracer: &Tracer, w: &Workload, tile: u32) -> (Vec<PixelResult>
     tiled.results()
 }
 
-/// Runs `warmup` untimed and `reps` timed traces of `w` on a pool of `threads` threads.
+/// Runs `warmup` untimed and `reps` timed traces of `w` on a pool of `threads` threads. Each timed run also
+/// runs `setup` when given: the preparation a method redoes whenever the geometry moves (DACRT's
+/// [`raylab_core::dacrt::Dacrt::new`]), so that its rates assume no structure prepared in advance.
 pub fn measure(
     tracer: &Tracer,
     w: &Workload,
     tile: u32,
-    threads: usize,
-    warmup: usize,
-    reps: usize,
+    (threads, warmup, reps): (usize, usize, usize),
+    setup: Option<&(dyn Fn() + Sync)>,
 ) -> Result<(TraceReport, Vec<PixelResult>), String> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -193,6 +194,9 @@ pub fn measure(
         }
         for _ in 0..reps.max(1) {
             let t0 = Instant::now();
+            if let Some(setup) = setup {
+                setup();
+            }
             tiled.trace(tracer);
             let secs = t0.elapsed().as_secs_f64();
             speeds.push(rays as f64 / secs.max(1e-12) / 1e6);

@@ -1,7 +1,7 @@
 //! Moving geometry for dynamic-scene work (seed 003 traces reflections of scenes that change every frame):
 //! a spinning mirror slab and a bouncing mirror ball added to any scene, sized to its bounds, and moved
 //! rigidly to the pose of any time. Moving vertices keeps triangle ids, so an MBVH can be refitted, a kd-tree
-//! must be rebuilt, and DACRT needs nothing.
+//! must be rebuilt, and DACRT only copies the triangles and divides the top of them again.
 
 use std::f32::consts::TAU;
 

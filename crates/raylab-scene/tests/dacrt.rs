@@ -121,6 +121,34 @@ fn small_sets_give_the_same_hits_forked_and_on_one_thread() {
     }
 }
 
+/// A scene several times [`raylab_core::dacrt::DIVIDE_ONCE_ABOVE`] triangles has the top of its division made
+/// at setup: calls with the SAH rule reuse it (whole sets, sets forked on two threads, single rays) and calls
+/// with the median rule divide for themselves; every way gives the reference's answers.
+#[test]
+fn the_division_made_at_setup_gives_the_same_hits() {
+    let mut mb = MeshBuilder::new();
+    for k in 0..4 {
+        mb.sphere(Vec3::new(3.0 * k as f32, 0.0, (k % 2) as f32), 1.2, 48, 64);
+    }
+    mb.cuboid(Vec3::new(-2.0, -1.5, -2.0), Vec3::new(11.0, -1.3, 3.0));
+    let scene = mb.build();
+    assert!(scene.triangle_count() > 4 * raylab_core::dacrt::DIVIDE_ONCE_ABOVE, "{}", scene.triangle_count());
+    let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let mut rays = adversarial_rays(&scene, &kd, 100, 13);
+    rays.extend(incoherent(&scene, 1500, 29));
+    let d = Dacrt::new(&scene);
+    assert!(d.setup_nodes() >= 7, "{} nodes divided at setup", d.setup_nodes());
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        for split in SplitRule::ALL {
+            let p = DacrtParams { split, ..DacrtParams::default() };
+            let what = format!("{split:?} on {threads} threads");
+            pool.install(|| check_sets(&scene, &d, &p, &rays, rays.len(), &what));
+            pool.install(|| check_sets(&scene, &d, &p, &rays[..60], 1, &what));
+        }
+    }
+}
+
 #[test]
 fn every_split_rule_and_leaf_threshold_gives_the_same_hits() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();

@@ -1,5 +1,5 @@
 //! Moving geometry: the animation moves its objects rigidly; after a move, a refitted MBVH, a rebuilt kd-tree
-//! and DACRT (which needs nothing) all equal brute force on the moved scene; bad moves are refused.
+//! and DACRT (set up again from the moved triangles) all equal brute force on the moved scene; bad moves are refused.
 
 mod common;
 

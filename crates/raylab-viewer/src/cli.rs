@@ -44,7 +44,7 @@ pub struct Cli {
     #[arg(long, default_value = "dacrt")]
     pub hybrid_method: raylab_core::method::Method,
     /// Move a spinning mirror and a bouncing ball every frame (the kd-tree is rebuilt, the MBVH refitted,
-    /// DACRT needs nothing; the panel shows what each update costs).
+    /// DACRT set up again; the panel shows what each update costs).
     #[arg(long)]
     pub animate: bool,
     /// Distribution mode: lens radius of the camera (0: pinhole).

@@ -20,7 +20,7 @@ use raylab_core::mbvh::Mbvh;
 use raylab_core::scene::Scene;
 
 use raylab_core::ray::Ray;
-use raylab_core::render::hybrid::{reflection_ray, shade_reflections};
+use raylab_core::render::hybrid::{reflection_ray, shade_reflection_set};
 use raylab_core::render::shade::to_display;
 use raylab_core::render::surface_epsilon;
 
@@ -404,16 +404,19 @@ fn send(tx: &Sender<WorkerEvent>, wake: &dyn Fn(), ev: WorkerEvent) {
     wake();
 }
 
-/// The R-buffer kept from frame to frame for interlacing, and which rows come next.
+/// The R-buffer (and its display bytes) kept from frame to frame for interlacing, and which rows come next.
 #[derive(Default)]
 struct Interlaced {
     size: (u32, u32),
     colors: Vec<[f32; 4]>,
+    rgba: Vec<[u8; 4]>,
     phase: u32,
 }
 
 /// Traces and shades the reflection rays of `r`'s G-buffer on the current rayon pool: every row, or every
-/// k-th row in turn when interlacing (the other rows keep the previous frame's reflections).
+/// k-th row in turn when interlacing (the other rows keep the previous frame's reflections). One pass over
+/// the G-buffer counts its reflective pixels and builds the rays of those in the traced rows; only those
+/// pixels are traced and written, so the cost follows the mirrors on screen rather than the G-buffer's size.
 fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rendered {
     let t0 = Instant::now();
     let job = &r.job;
@@ -421,38 +424,50 @@ fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rend
     let (w, h) = (g.width, g.height);
     let k = job.settings.hybrid.interlace.max(1);
     if kept.size != (w, h) || kept.colors.len() != g.pixels.len() {
-        *kept = Interlaced { size: (w, h), colors: vec![[0.0, 0.0, 0.0, 1.0]; g.pixels.len()], phase: 0 };
+        let n = g.pixels.len();
+        *kept =
+            Interlaced { size: (w, h), colors: vec![[0.0, 0.0, 0.0, 1.0]; n], rgba: vec![[0, 0, 0, 255]; n], phase: 0 };
     }
     let phase = kept.phase % k;
     kept.phase = kept.phase.wrapping_add(1);
     let eps = surface_epsilon(s.scene);
-    let traced_row = |i: usize| (i / w as usize) as u32 % k == phase;
-    let rays: Vec<Option<Ray>> = g
-        .pixels
-        .iter()
-        .enumerate()
-        .map(|(i, p)| if traced_row(i) { reflection_ray(job.camera.eye, p, eps) } else { None })
-        .collect();
+    let row_len = (w as usize).max(1);
+    let mut reflective = 0;
+    let mut set: Vec<(u32, Ray)> = Vec::new();
+    for (y, row) in g.pixels.chunks(row_len).enumerate() {
+        let traced = y as u32 % k == phase;
+        for (x, p) in row.iter().enumerate() {
+            if p.material.is_none() || p.reflect <= 0.0 {
+                continue;
+            }
+            reflective += 1;
+            if traced && let Some(ray) = reflection_ray(job.camera.eye, p, eps) {
+                set.push(((y * row_len + x) as u32, ray));
+            }
+        }
+    }
     let settings = job.settings.render_settings(w, h);
     let options = raylab_core::trace::TraceOptions { method: job.settings.hybrid.method, ..job.settings.trace };
     let tracer = Tracer::new(s.tree, None, options).with_mbvh(s.mbvh).with_dacrt(s.dacrt);
-    let (colors, stats, stages) = shade_reflections(s.scene, &tracer, &job.camera, job.light, &settings, &rays);
-    for (i, c) in colors.iter().enumerate() {
-        if traced_row(i) {
-            kept.colors[i] = [c.x, c.y, c.z, 1.0];
-        }
+    let (colors, stats, stages) = shade_reflection_set(s.scene, &tracer, &job.camera, job.light, &settings, &set);
+    // The traced rows start black; then their reflective pixels get their colours.
+    let rows = kept.colors.chunks_mut(row_len).zip(kept.rgba.chunks_mut(row_len));
+    for (_, (colors, rgba)) in rows.enumerate().filter(|(y, _)| *y as u32 % k == phase) {
+        colors.fill([0.0, 0.0, 0.0, 1.0]);
+        rgba.fill([0, 0, 0, 255]);
     }
-    // Most pixels reflect nothing: skip the gamma curve for black.
-    let show = |v: f32| if v > 0.0 { to_display(v) } else { 0 };
-    let rgba = kept.colors.iter().map(|c| [show(c[0]), show(c[1]), show(c[2]), 255]).collect();
+    for (&(i, _), c) in set.iter().zip(&colors) {
+        kept.colors[i as usize] = [c.x, c.y, c.z, 1.0];
+        kept.rgba[i as usize] = [to_display(c.x), to_display(c.y), to_display(c.z), 255];
+    }
     let trace_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let frame = Frame { width: w, height: h, rgba, stats, stages, range: None };
+    let frame = Frame { width: w, height: h, rgba: kept.rgba.clone(), stats, stages, range: None };
     let hybrid = HybridFrame {
         size: (w, h),
         rbuffer: kept.colors.clone(),
         eye: job.camera.eye,
-        reflective: g.pixels.iter().filter(|p| p.material.is_some() && p.reflect > 0.0).count(),
-        rays: rays.iter().filter(|r| r.is_some()).count(),
+        reflective,
+        rays: set.len(),
         raster_ms: r.raster_ms,
         readback_ms: r.readback_ms,
         trace_ms,

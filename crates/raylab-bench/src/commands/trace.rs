@@ -97,8 +97,10 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     if let Some(d) = &dacrt {
         tracer = tracer.with_dacrt(d);
     }
-    let (report, results) =
-        measure(&tracer, &workload, tile as u32, a.threads as usize, a.warmup as usize, a.reps as usize)?;
+    let setup = || drop(Dacrt::new(&scene));
+    let setup = dacrt.as_ref().map(|_| &setup as &(dyn Fn() + Sync));
+    let runs = (a.threads as usize, a.warmup as usize, a.reps as usize);
+    let (report, results) = measure(&tracer, &workload, tile as u32, runs, setup)?;
     let checked = with_spinner("validating against brute force", || {
         validate(&reference, &workload, &results, a.validate as usize)
     })

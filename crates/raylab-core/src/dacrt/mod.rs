@@ -4,9 +4,13 @@
 //! in two ([`split`]), the rays filtered against each half's box in SIMD ([`filter`]), and each half recursed
 //! with the rays that reach it ([`traverse`]), until few rays or few triangles are left to test naively.
 //!
-//! The only preparation is a linear pass that copies the triangles and their boxes ([`Dacrt::new`]), so
-//! geometry that moves every frame costs nothing to "rebuild". The work is amortised over the rays of one
-//! call: DACRT wants large ray sets (a whole G-buffer's reflection rays, or large tiles), not single rays.
+//! The only preparation ([`Dacrt::new`]) copies the triangles and their boxes and makes the top of the
+//! division every call would begin with (sets above [`DIVIDE_ONCE_ABOVE`] triangles, a few linear passes), so
+//! geometry that moves every frame costs milliseconds to "rebuild", and a call's own work starts a few levels
+//! down: calls of a few thousand rays (the hybrid mode's reflection and shadow rays) would otherwise spend
+//! most of their time dividing the whole scene again. The benchmarks time that setup with every traced frame.
+//! The rest of the work is amortised over the rays of one call: DACRT wants large ray sets (a whole
+//! G-buffer's reflection rays, or large tiles), not single rays.
 
 mod filter;
 mod partition;
@@ -28,6 +32,7 @@ use crate::scene::Scene;
 use crate::stats::TraversalStats;
 use crate::triangle::TriangleSoup;
 use records::{RayRecord, SetBounds, TriRecord};
+use split::Split;
 use traverse::{Answer, Any, Blocker, Closest, Walk, beats};
 
 /// When DACRT stops dividing and how it divides.
@@ -58,19 +63,54 @@ impl DacrtParams {
 /// first shortens the rays before the farther one, and the renderers trace several such sets at once.
 pub const FORK_BELOW: usize = 16384;
 
-/// Triangles `tris` of [`Dacrt`]'s references, bounded by `bounds`.
+/// Sets of more triangles than this are divided once, at setup, rather than by every call: about the top
+/// five levels on scenes of 100k triangles, which every ray set would otherwise divide again.
+pub const DIVIDE_ONCE_ABOVE: usize = 4096;
+
+/// Triangles `tris` of [`Dacrt`]'s references, bounded by `bounds`; `top` is the node of the setup's division
+/// they form, if any.
 #[derive(Clone, Debug)]
 struct Group {
     tris: Range<usize>,
     bounds: SetBounds,
+    top: Option<u32>,
+}
+
+/// A node of the division made at setup ([`DIVIDE_ONCE_ABOVE`]): the split of its triangles and its two
+/// children's nodes, or `None` where the calls divide for themselves.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TopNode {
+    split: Option<(Split, [u32; 2])>,
+}
+
+/// Divides `refs` (bounded by `bounds`) by the SAH while they hold more than [`DIVIDE_ONCE_ABOVE`]
+/// triangles, the two halves of each split on two threads where the rayon pool has them; returns the nodes
+/// depth first, `refs`' own node first.
+fn divide_top(refs: &mut [TriRecord], bounds: &SetBounds) -> Vec<TopNode> {
+    let split = (refs.len() > DIVIDE_ONCE_ABOVE)
+        .then(|| split::divide(refs, bounds, SplitRule::Sah, &mut Vec::new()))
+        .flatten();
+    let Some(s) = split else { return vec![TopNode { split: None }] };
+    let (first, second) = refs.split_at_mut(s.mid);
+    let (a, b) = rayon::join(|| divide_top(first, &s.first), || divide_top(second, &s.second));
+    let shift = |nodes: Vec<TopNode>, by: u32| {
+        nodes.into_iter().map(move |n| TopNode { split: n.split.map(|(s, c)| (s, c.map(|i| i + by))) })
+    };
+    let (first_at, second_at) = (1, 1 + a.len() as u32);
+    let mut nodes = vec![TopNode { split: Some((s, [first_at, second_at])) }];
+    nodes.extend(shift(a, first_at));
+    nodes.extend(shift(b, second_at));
+    nodes
 }
 
 /// Per-call working memory: the triangle references (a permutation of the scene's, reused from call to call),
-/// the moved rays and the filter's flags.
+/// the moved rays and the filter's flags. `tris` keeps the setup's division (each of its nodes' triangles in
+/// that node's range) as long as only calls that reuse it have permuted them.
 struct Scratch {
     tris: Vec<TriRecord>,
     rays: Vec<RayRecord>,
     flags: Vec<u8>,
+    keeps_setup_division: bool,
 }
 
 /// A scene prepared for divide-and-conquer tracing: its triangles and their boxes, nothing more.
@@ -78,10 +118,10 @@ pub struct Dacrt {
     soup: TriangleSoup,
     refs: Vec<TriRecord>,
     root: SetBounds,
-    /// The triangles divided once, at setup, into two groups of `refs` (the division every call would make
-    /// first), so that a small ray set can be traced against each group on its own thread
-    /// ([`FORK_BELOW`]); `None` for fewer than two triangles.
-    groups: Option<[Group; 2]>,
+    /// The top of the division every call would make, made once at setup on `refs` (node 0 holds them all):
+    /// calls with the SAH rule reuse it, and a small ray set is traced against the two halves of the first
+    /// split on two threads ([`FORK_BELOW`]).
+    top: Vec<TopNode>,
     setup_time: Duration,
     /// Working memory of finished calls, reused by the next ones (one per thread that traced).
     pool: Mutex<Vec<Scratch>>,
@@ -90,20 +130,20 @@ pub struct Dacrt {
 }
 
 impl Dacrt {
-    /// Copies the triangles of `scene` and their boxes: a linear pass, the whole "build".
+    /// Copies the triangles of `scene` and their boxes and divides the top of them ([`DIVIDE_ONCE_ABOVE`]):
+    /// a few linear passes, the whole "build", redone whenever the geometry moves.
     pub fn new(scene: &Scene) -> Self {
         let start = Instant::now();
         let soup = TriangleSoup::from_scene(scene);
         let mut refs: Vec<TriRecord> =
             soup.as_slice().iter().enumerate().map(|(i, t)| TriRecord::new(*t, i as u32)).collect();
         let root = SetBounds::of(&refs);
-        let groups = split::divide(&mut refs, &root, SplitRule::Sah, &mut Vec::new())
-            .map(|s| [Group { tris: 0..s.mid, bounds: s.first }, Group { tris: s.mid..refs.len(), bounds: s.second }]);
+        let top = divide_top(&mut refs, &root);
         Self {
             soup,
             refs,
             root,
-            groups,
+            top,
             setup_time: start.elapsed(),
             pool: Mutex::new(Vec::new()),
             backend: Backend::detect(),
@@ -113,6 +153,12 @@ impl Dacrt {
     /// How long [`Dacrt::new`] took.
     pub fn setup_time(&self) -> Duration {
         self.setup_time
+    }
+
+    /// Nodes of the division made at setup ([`DIVIDE_ONCE_ABOVE`]): 1 when the scene is too small to divide
+    /// in advance, 0 when it is empty.
+    pub fn setup_nodes(&self) -> usize {
+        self.top.len()
     }
 
     /// Number of triangles.
@@ -188,14 +234,18 @@ impl Dacrt {
 
     /// The groups to trace a set of `rays` rays against on two threads, when the current rayon pool has them
     /// and the set is small enough that dividing the triangles, not the rays' own work, is most of its cost.
-    fn fork(&self, rays: usize) -> Option<&[Group; 2]> {
+    fn fork(&self, rays: usize) -> Option<[Group; 2]> {
         (rays < FORK_BELOW && rayon::current_num_threads() > 1).then_some(())?;
-        self.groups.as_ref()
+        let (s, [a, b]) = self.top.first()?.split?;
+        Some([
+            Group { tris: 0..s.mid, bounds: s.first, top: Some(a) },
+            Group { tris: s.mid..self.refs.len(), bounds: s.second, top: Some(b) },
+        ])
     }
 
     /// All triangles as one group.
     fn whole(&self) -> Group {
-        Group { tris: 0..self.refs.len(), bounds: self.root }
+        Group { tris: 0..self.refs.len(), bounds: self.root, top: (!self.top.is_empty()).then_some(0) }
     }
 
     /// Traces `rays` against each of the two `groups` on its own thread, each answer into its own output;
@@ -204,7 +254,7 @@ impl Dacrt {
         &self,
         p: &DacrtParams,
         rays: &[Option<Ray>],
-        groups: &[Group; 2],
+        groups: [Group; 2],
         [first, second]: [A; 2],
         stats: &mut TraversalStats,
     ) {
@@ -236,9 +286,17 @@ impl Dacrt {
         );
         stats.rays += scratch.rays.len() as u64;
         stats.packets += scratch.rays.len() as u64;
+        // The SAH rule reuses the setup's division and a part of the triangles is one of its nodes: both need
+        // the references as the setup left them, which a call by another rule may have permuted.
+        let reuses = p.split == SplitRule::Sah;
+        if (reuses || group.tris.len() != self.refs.len()) && !scratch.keeps_setup_division {
+            scratch.tris.copy_from_slice(&self.refs);
+        }
+        scratch.keeps_setup_division = reuses;
         if !scratch.rays.is_empty() && !group.tris.is_empty() {
             let mut walk = Walk {
                 soup: &self.soup,
+                top: if reuses { &self.top } else { &[] },
                 params: *p,
                 answer,
                 flags: std::mem::take(&mut scratch.flags),
@@ -250,7 +308,7 @@ impl Dacrt {
             let filter_box = filter::FilterBox::new(&group.bounds.bounds);
             let k = filter::filter(walk.backend, rays, &filter_box, &mut walk.flags);
             if k > 0 {
-                walk.recurse(&mut rays[..k], &mut tris[group.tris], group.bounds, 0);
+                walk.recurse(&mut rays[..k], &mut tris[group.tris], group.bounds, group.top, 0);
             }
             scratch.flags = walk.flags;
             *stats += walk.stats;
@@ -260,7 +318,12 @@ impl Dacrt {
 
     fn take_scratch(&self) -> Scratch {
         let reused = self.pool.lock().unwrap_or_else(|e| e.into_inner()).pop();
-        reused.unwrap_or_else(|| Scratch { tris: self.refs.clone(), rays: Vec::new(), flags: Vec::new() })
+        reused.unwrap_or_else(|| Scratch {
+            tris: self.refs.clone(),
+            rays: Vec::new(),
+            flags: Vec::new(),
+            keeps_setup_division: true,
+        })
     }
 }
 

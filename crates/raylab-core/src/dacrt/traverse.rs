@@ -5,11 +5,11 @@
 
 use raylab_simd::{Backend, Kernel, VMask, Vf32};
 
-use super::DacrtParams;
 use super::filter::{FilterBox, classify};
 use super::partition::partition;
 use super::records::{RayRecord, SetBounds, TriRecord};
 use super::split::divide;
+use super::{DacrtParams, TopNode};
 use crate::packet::{MAX_LANES, PacketHits, RayPacket, intersect_packet, occlude_packet};
 use crate::ray::Hit;
 use crate::stats::TraversalStats;
@@ -156,6 +156,8 @@ impl Answer for Blocker<'_> {
 /// One recursion's shared state.
 pub(super) struct Walk<'a, A> {
     pub soup: &'a TriangleSoup,
+    /// The division made at setup (empty when the calls divide by another rule).
+    pub top: &'a [TopNode],
     pub params: DacrtParams,
     pub answer: A,
     /// Scratch flags for the filter.
@@ -166,12 +168,25 @@ pub(super) struct Walk<'a, A> {
 }
 
 impl<A: Answer> Walk<'_, A> {
-    /// Traces `rays` against `tris` (bounded by `b`).
-    pub fn recurse(&mut self, rays: &mut [RayRecord], tris: &mut [TriRecord], b: SetBounds, depth: u32) {
+    /// Traces `rays` against `tris` (bounded by `b`), which form node `top` of the setup's division, if any.
+    pub fn recurse(
+        &mut self,
+        rays: &mut [RayRecord],
+        tris: &mut [TriRecord],
+        b: SetBounds,
+        top: Option<u32>,
+        depth: u32,
+    ) {
         self.stats.nodes += 1;
         let p = self.params;
         let small = tris.len() <= p.leaf_tris || rays.len() <= p.leaf_rays;
-        let split = if small || depth >= MAX_DEPTH { None } else { divide(tris, &b, p.split, &mut self.flags) };
+        let made = top.and_then(|i| self.top.get(i as usize)?.split);
+        let split = match made {
+            _ if small || depth >= MAX_DEPTH => None,
+            Some((s, _)) => Some(s),
+            None => divide(tris, &b, p.split, &mut self.flags),
+        };
+        let children = made.map(|(_, c)| c);
         let Some(s) = split else {
             self.stats.leaves += 1;
             self.stats.isect_tests += (rays.len() * tris.len()) as u64;
@@ -183,8 +198,12 @@ impl<A: Answer> Walk<'_, A> {
         let forward =
             rays.iter().step_by(step).filter(|r| r.dir[s.axis] >= 0.0).count() * 2 >= rays.len().div_ceil(step);
         let (lower, upper) = tris.split_at_mut(s.mid);
-        let ((near, near_b), (far, far_b)) =
-            if forward { ((lower, s.first), (upper, s.second)) } else { ((upper, s.second), (lower, s.first)) };
+        let [first_top, second_top] = children.map_or([None; 2], |c| c.map(Some));
+        let ((near, near_b, near_top), (far, far_b, far_top)) = if forward {
+            ((lower, s.first, first_top), (upper, s.second, second_top))
+        } else {
+            ((upper, s.second, second_top), (lower, s.first, first_top))
+        };
         // One pass against both boxes: [near (maybe far too) | far only | neither].
         let boxes = [FilterBox::new(&near_b.bounds), FilterBox::new(&far_b.bounds)];
         self.stats.box_tests += 2 * rays.len() as u64;
@@ -193,7 +212,7 @@ impl<A: Answer> Walk<'_, A> {
         let to_near = partition(rays, &mut self.flags[..n], |f| f & 1 != 0);
         let far_only = partition(&mut rays[to_near..], &mut self.flags[to_near..n], |f| f & 2 != 0);
         if to_near > 0 {
-            self.recurse(&mut rays[..to_near], near, near_b, depth + 1);
+            self.recurse(&mut rays[..to_near], near, near_b, near_top, depth + 1);
         }
         // The near half's rays test the far box again with their shortened intervals; those that enter it go
         // to the back of their range, next to the far-only rays.
@@ -202,7 +221,7 @@ impl<A: Answer> Walk<'_, A> {
         classify(self.backend, near_rays, &[boxes[1]], &mut self.flags);
         let stay = partition(near_rays, &mut self.flags[..to_near], |f| f == 0);
         if stay < to_near + far_only {
-            self.recurse(&mut rays[stay..to_near + far_only], far, far_b, depth + 1);
+            self.recurse(&mut rays[stay..to_near + far_only], far, far_b, far_top, depth + 1);
         }
     }
 }

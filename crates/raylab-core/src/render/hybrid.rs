@@ -52,9 +52,8 @@ const MIN_CHUNK: usize = 256;
 
 /// Linear colours of a `width x height` layer of reflection rays (one slot per pixel, `None` where none is
 /// traced), traced with `tracer` and shaded one bounce deep under `settings.shadows`; black where there is no
-/// ray or no hit. Only the rays present are traced: gathered in pixel order into sets shared among the
-/// threads of the current rayon pool (for DACRT, sets of at least [`Method::DACRT_MIN_SET`] rays, since each
-/// set divides the whole scene again). Returns the colours, the work and the time per stage.
+/// ray or no hit. The per-pixel form of [`shade_reflection_set`]. Returns the colours, the work and the time
+/// per stage.
 pub fn shade_reflections(
     scene: &Scene,
     tracer: &Tracer,
@@ -65,10 +64,33 @@ pub fn shade_reflections(
 ) -> (Vec<Vec3>, TraversalStats, StageTimes) {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     assert_eq!(rays.len(), (w * h) as usize, "one ray slot per pixel");
-    let present: Vec<usize> = rays.iter().enumerate().filter(|(_, r)| r.is_some()).map(|(i, _)| i).collect();
+    let set: Vec<(u32, Ray)> = rays.iter().enumerate().filter_map(|(i, r)| r.map(|r| (i as u32, r))).collect();
+    let (found, stats, stages) = shade_reflection_set(scene, tracer, camera, light, settings, &set);
+    let mut colors = vec![Vec3::ZERO; rays.len()];
+    for (&(i, _), c) in set.iter().zip(found) {
+        colors[i as usize] = c;
+    }
+    (colors, stats, stages)
+}
+
+/// Linear colours of the reflection rays `set` (each with the index of its pixel in the `width x height`
+/// layer of `settings`, which seeds its light samples), traced with `tracer` and shaded one bounce deep under
+/// `settings.shadows`, in the order of `set`; black where a ray hits nothing. The rays are cut into sets
+/// shared among the threads of the current rayon pool (for DACRT, sets of at least
+/// [`Method::DACRT_MIN_SET`] rays, since each set divides the whole scene again). The hybrid mode passes only
+/// its reflective pixels, so its cost follows their number rather than the G-buffer's size.
+pub fn shade_reflection_set(
+    scene: &Scene,
+    tracer: &Tracer,
+    camera: &Camera,
+    light: PointLight,
+    settings: &RenderSettings,
+    set: &[(u32, Ray)],
+) -> (Vec<Vec3>, TraversalStats, StageTimes) {
+    let (w, h) = (settings.width.max(1), settings.height.max(1));
     let threads = rayon::current_num_threads().max(1);
     let min_set = if tracer.options.method.uses_dacrt() { Method::DACRT_MIN_SET as usize } else { MIN_CHUNK };
-    let chunk = present.len().div_ceil(threads).max(min_set).max(1);
+    let chunk = set.len().div_ceil(threads).max(min_set).max(1);
     let one_bounce = RenderSettings { max_depth: 1, ..*settings };
     let ctx = TileContext {
         scene,
@@ -82,28 +104,26 @@ pub fn shade_reflections(
         tile: settings.tile,
         offsets: Vec::new(),
     };
-    let sets: Vec<(Vec<Vec3>, TileOut)> = present
+    let sets: Vec<(Vec<Vec3>, TileOut)> = set
         .par_chunks(chunk)
-        .map(|ids| {
-            let set: Vec<Option<Ray>> = ids.iter().map(|&i| rays[i]).collect();
-            let seeds: Vec<u32> = ids.iter().map(|&i| reflection_seed(i as u32)).collect();
+        .map(|part| {
+            let rays: Vec<Option<Ray>> = part.iter().map(|&(_, r)| Some(r)).collect();
+            let seeds: Vec<u32> = part.iter().map(|&(i, _)| reflection_seed(i)).collect();
             let mut out = TileOut::default();
             let t0 = std::time::Instant::now();
-            let mut hits = vec![None; set.len()];
-            tracer.intersect_tile(&set, set.len(), 1, &mut hits, &mut out.stats);
+            let mut hits = vec![None; rays.len()];
+            tracer.intersect_tile(&rays, rays.len(), 1, &mut hits, &mut out.stats);
             out.stages.secondary += t0.elapsed().as_secs_f64();
             out.stages.secondary_tests += out.stats.isect_tests;
-            let layer = Layer { rays: &set, hits: &hits, dims: (set.len(), 1), seeds: &seeds };
+            let layer = Layer { rays: &rays, hits: &hits, dims: (rays.len(), 1), seeds: &seeds };
             let colors = ctx.shade_layer(layer, 1, &mut out, &mut ShadowScratch::default());
             (colors, out)
         })
         .collect();
-    let mut colors = vec![Vec3::ZERO; rays.len()];
+    let mut colors = Vec::with_capacity(set.len());
     let (mut stats, mut stages) = (TraversalStats::default(), StageTimes::default());
-    for (ids, (c, out)) in present.chunks(chunk).zip(sets) {
-        for (&i, c) in ids.iter().zip(c) {
-            colors[i] = c;
-        }
+    for (c, out) in sets {
+        colors.extend(c);
         stats += out.stats;
         stages += out.stages;
     }

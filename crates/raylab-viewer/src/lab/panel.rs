@@ -243,7 +243,9 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
             s.mode != RenderMode::Hybrid,
             egui::Checkbox::new(&mut s.animate, "animate (spinning mirror, bouncing ball)"),
         )
-        .on_hover_text("move objects every frame: the kd-tree is rebuilt, the MBVH refitted, DACRT needs nothing")
+        .on_hover_text(
+            "move objects every frame: the kd-tree is rebuilt, the MBVH refitted, DACRT set up again (milliseconds)",
+        )
         .on_disabled_hover_text("the hybrid mode rasterises the loaded scene, which does not move yet");
         if let Some(u) = animation.filter(|_| s.animate) {
             animation_readout(ui, &u);
