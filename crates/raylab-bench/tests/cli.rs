@@ -350,7 +350,7 @@ fn dacrt_traces_and_animate_reports_every_update_strategy() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let table = std::fs::read_to_string(&md).unwrap();
-    for row in ["| mono | kd-tree rebuilt |", "| mbvh | MBVH refitted |", "| dacrt | none (DACRT) |"] {
+    for row in ["| mono | kd-tree rebuilt |", "| mbvh | MBVH refitted |", "| dacrt | triangles copied, top divided |"] {
         assert!(table.contains(row), "{row} missing from:\n{table}");
     }
     let o = bench(&["animate", "--frames", "0"], dir.path());

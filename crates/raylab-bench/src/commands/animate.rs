@@ -78,7 +78,11 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
     let (mut scene, anim) = Animation::add_movers(&base);
     let params = a.kd.params()?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string())?;
-    let methods = [(Method::Mono, "kd-tree rebuilt"), (Method::Mbvh, "MBVH refitted"), (Method::Dacrt, "none (DACRT)")];
+    let methods = [
+        (Method::Mono, "kd-tree rebuilt"),
+        (Method::Mbvh, "MBVH refitted"),
+        (Method::Dacrt, "triangles copied, top divided"),
+    ];
     let mut rows = vec![Row::default(); methods.len()];
     let mut mbvh = pool.install(|| Mbvh::build(&scene));
     let mut rays = 0;
