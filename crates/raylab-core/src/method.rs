@@ -91,7 +91,7 @@ impl Method {
 
 impl Method {
     /// Fewest rays the renderers hand DACRT as one set: below this its per-set cost (dividing the triangles
-    /// near the top of the recursion, whatever the number of rays) outweighs the rays' own work.
+    /// below the division made at setup, whatever the number of rays) outweighs the rays' own work.
     pub const DACRT_MIN_SET: u32 = 16384;
 
     /// True for divide-and-conquer ray tracing, which needs a [`Dacrt`] instead of a stored structure.

@@ -40,6 +40,19 @@ fn incoherent(scene: &Scene, n: usize, seed: u32) -> Vec<Ray> {
         .collect()
 }
 
+/// `adversarial` adversarial rays (seeded by `adversarial_seed`) then `random` incoherent ones (`random_seed`)
+/// for `scene`.
+fn mixed_rays(
+    scene: &Scene,
+    (adversarial, adversarial_seed): (usize, u32),
+    (random, random_seed): (usize, u32),
+) -> Vec<Ray> {
+    let kd = KdTree::build(scene, &KdParams::default()).unwrap();
+    let mut rays = adversarial_rays(scene, &kd, adversarial, adversarial_seed);
+    rays.extend(incoherent(scene, random, random_seed));
+    rays
+}
+
 /// Traces `rays` with `d` in sets of `set` rays and checks closest hits, occlusion and blockers against
 /// brute force. Returns the counters.
 fn check_sets(scene: &Scene, d: &Dacrt, p: &DacrtParams, rays: &[Ray], set: usize, what: &str) -> TraversalStats {
@@ -80,9 +93,7 @@ fn check_sets(scene: &Scene, d: &Dacrt, p: &DacrtParams, rays: &[Ray], set: usiz
 fn dacrt_matches_brute_force_on_every_builtin_scene() {
     for name in builtin::names() {
         let scene = builtin::build(name, Detail::Test).unwrap();
-        let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-        let mut rays = adversarial_rays(&scene, &kd, 150, 3);
-        rays.extend(incoherent(&scene, 2500, 11));
+        let rays = mixed_rays(&scene, (150, 3), (2500, 11));
         let mut d = Dacrt::new(&scene);
         let p = DacrtParams::default();
         for backend in Backend::available() {
@@ -106,9 +117,7 @@ fn dacrt_matches_brute_force_on_every_builtin_scene() {
 #[test]
 fn small_sets_give_the_same_hits_forked_and_on_one_thread() {
     let scene = builtin::build("kitchen", Detail::Test).unwrap();
-    let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let mut rays = adversarial_rays(&scene, &kd, 100, 7);
-    rays.extend(incoherent(&scene, 1200, 23));
+    let rays = mixed_rays(&scene, (100, 7), (1200, 23));
     assert!(rays.len() < raylab_core::dacrt::FORK_BELOW);
     let d = Dacrt::new(&scene);
     for threads in [1, 2, 3] {
@@ -133,9 +142,7 @@ fn the_division_made_at_setup_gives_the_same_hits() {
     mb.cuboid(Vec3::new(-2.0, -1.5, -2.0), Vec3::new(11.0, -1.3, 3.0));
     let scene = mb.build();
     assert!(scene.triangle_count() > 4 * raylab_core::dacrt::DIVIDE_ONCE_ABOVE, "{}", scene.triangle_count());
-    let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let mut rays = adversarial_rays(&scene, &kd, 100, 13);
-    rays.extend(incoherent(&scene, 1500, 29));
+    let rays = mixed_rays(&scene, (100, 13), (1500, 29));
     let d = Dacrt::new(&scene);
     assert!(d.setup_nodes() >= 7, "{} nodes divided at setup", d.setup_nodes());
     for threads in [1, 2] {
@@ -152,9 +159,7 @@ fn the_division_made_at_setup_gives_the_same_hits() {
 #[test]
 fn every_split_rule_and_leaf_threshold_gives_the_same_hits() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();
-    let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let mut rays = adversarial_rays(&scene, &kd, 100, 5);
-    rays.extend(incoherent(&scene, 1500, 17));
+    let rays = mixed_rays(&scene, (100, 5), (1500, 17));
     let d = Dacrt::new(&scene);
     for split in SplitRule::ALL {
         for (leaf_rays, leaf_tris) in [(1, 1), (8, 8), (64, 2), (2, 64), (DacrtParams::MAX_LEAF, 1)] {

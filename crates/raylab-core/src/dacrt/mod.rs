@@ -113,7 +113,7 @@ struct Scratch {
     keeps_setup_division: bool,
 }
 
-/// A scene prepared for divide-and-conquer tracing: its triangles and their boxes, nothing more.
+/// A scene prepared for divide-and-conquer tracing: its triangles, their boxes and the top of their division.
 pub struct Dacrt {
     soup: TriangleSoup,
     refs: Vec<TriRecord>,

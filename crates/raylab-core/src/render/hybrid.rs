@@ -77,8 +77,9 @@ pub fn shade_reflections(
 /// layer of `settings`, which seeds its light samples), traced with `tracer` and shaded one bounce deep under
 /// `settings.shadows`, in the order of `set`; black where a ray hits nothing. The rays are cut into sets
 /// shared among the threads of the current rayon pool (for DACRT, sets of at least
-/// [`Method::DACRT_MIN_SET`] rays, since each set divides the whole scene again). The hybrid mode passes only
-/// its reflective pixels, so its cost follows their number rather than the G-buffer's size.
+/// [`Method::DACRT_MIN_SET`] rays, since each set divides its triangles again below the setup's division).
+/// The hybrid mode passes only its reflective pixels, so its cost follows their number rather than the
+/// G-buffer's size.
 pub fn shade_reflection_set(
     scene: &Scene,
     tracer: &Tracer,
