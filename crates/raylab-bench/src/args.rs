@@ -219,7 +219,7 @@ pub struct MethodArgs {
     /// Walk MBVH RS child tasks in lane order instead of by accumulated hit length (to measure the ordering).
     #[arg(long)]
     pub no_stream_order: bool,
-    /// DACRT: a node with at most this many rays is tested naively.
+    /// DACRT: a node with at most this many rays is tested naively (below the division made at setup).
     #[arg(long, default_value_t = 8, value_parser = in_range(1, raylab_core::dacrt::DacrtParams::MAX_LEAF as u64))]
     pub dacrt_leaf_rays: u64,
     /// DACRT: a node with at most this many triangles is tested naively.

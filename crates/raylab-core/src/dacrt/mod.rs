@@ -6,9 +6,11 @@
 //!
 //! The only preparation ([`Dacrt::new`]) copies the triangles and their boxes and makes the top of the
 //! division every call would begin with (sets above [`DIVIDE_ONCE_ABOVE`] triangles, a few linear passes), so
-//! geometry that moves every frame costs milliseconds to "rebuild", and a call's own work starts a few levels
-//! down: calls of a few thousand rays (the hybrid mode's reflection and shadow rays) would otherwise spend
-//! most of their time dividing the whole scene again. The benchmarks time that setup with every traced frame.
+//! geometry that moves every frame costs milliseconds to "rebuild", and a call's own work starts several
+//! levels down: calls of a few thousand rays (the hybrid mode's reflection and shadow rays) would otherwise
+//! spend most of their time dividing the whole scene again, and, since such a set thins out to a few rays per
+//! node long before the triangles do, test each of those rays against hundreds of triangles. The benchmarks
+//! time that setup with every traced frame.
 //! The rest of the work is amortised over the rays of one call: DACRT wants large ray sets (a whole
 //! G-buffer's reflection rays, or large tiles), not single rays.
 
@@ -38,7 +40,9 @@ use traverse::{Answer, Any, Blocker, Closest, Walk, beats};
 /// When DACRT stops dividing and how it divides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct DacrtParams {
-    /// A node with at most this many rays is tested naively.
+    /// A node with at most this many rays is tested naively, unless the setup already divided it (then its
+    /// division costs nothing, and following it filters the rays against boxes instead of testing them
+    /// against all of the node's triangles).
     pub leaf_rays: usize,
     /// A node with at most this many triangles is tested naively.
     pub leaf_tris: usize,
@@ -64,8 +68,11 @@ impl DacrtParams {
 pub const FORK_BELOW: usize = 16384;
 
 /// Sets of more triangles than this are divided once, at setup, rather than by every call: about the top
-/// five levels on scenes of 100k triangles, which every ray set would otherwise divide again.
-pub const DIVIDE_ONCE_ABOVE: usize = 4096;
+/// nine levels on scenes of 100k triangles, which every ray set would otherwise divide again. Deep enough that
+/// a few thousand reflection rays, which reach nodes of this size in ones and twos, test few triangles each
+/// (the hybrid mode's rays on the atrium: 173 triangle tests per ray with 4,096, 54 with 256); shallow enough
+/// that the setup stays a few milliseconds, since moving geometry redoes it every frame.
+pub const DIVIDE_ONCE_ABOVE: usize = 256;
 
 /// Triangles `tris` of [`Dacrt`]'s references, bounded by `bounds`; `top` is the node of the setup's division
 /// they form, if any.

@@ -179,8 +179,8 @@ impl<A: Answer> Walk<'_, A> {
     ) {
         self.stats.nodes += 1;
         let p = self.params;
-        let small = tris.len() <= p.leaf_tris || rays.len() <= p.leaf_rays;
         let made = top.and_then(|i| self.top.get(i as usize)?.split);
+        let small = tris.len() <= p.leaf_tris || (made.is_none() && rays.len() <= p.leaf_rays);
         let split = match made {
             _ if small || depth >= MAX_DEPTH => None,
             Some((s, _)) => Some(s),

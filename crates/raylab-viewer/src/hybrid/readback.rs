@@ -133,34 +133,33 @@ impl Readback {
             }
         }
         let (w, h) = s.size;
-        let read = |b: &wgpu::Buffer| -> Result<Vec<[f32; 4]>, String> {
-            let view = b.slice(..).get_mapped_range().map_err(|e| format!("G-buffer readback: {e}"))?;
-            let mut out = Vec::with_capacity((w * h) as usize);
+        let texel = |t: &[u8]| -> [f32; 4] {
+            std::array::from_fn(|k| f32::from_le_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]]))
+        };
+        // One pass over both mapped buffers, row by row (rows are padded to the copy alignment).
+        let pixels = {
+            let position = s.position.slice(..).get_mapped_range().map_err(|e| format!("G-buffer readback: {e}"))?;
+            let normal = s.normal.slice(..).get_mapped_range().map_err(|e| format!("G-buffer readback: {e}"))?;
+            let mut pixels = Vec::with_capacity((w * h) as usize);
             for y in 0..h as usize {
-                let row = &view[y * s.row as usize..][..(w * TEXEL) as usize];
-                out.extend(row.chunks_exact(16).map(|t| {
-                    std::array::from_fn(|k| f32::from_le_bytes([t[4 * k], t[4 * k + 1], t[4 * k + 2], t[4 * k + 3]]))
+                let row = y * s.row as usize..y * s.row as usize + (w * TEXEL) as usize;
+                let texels = position[row.clone()].chunks_exact(16).zip(normal[row].chunks_exact(16));
+                pixels.extend(texels.map(|(p, n)| {
+                    let (p, n) = (texel(p), texel(n));
+                    let id = p[3].round();
+                    GPixel {
+                        position: Vec3::new(p[0], p[1], p[2]),
+                        material: (id >= 1.0).then(|| id as u32 - 1),
+                        normal: Vec3::new(n[0], n[1], n[2]),
+                        reflect: if id >= 1.0 { n[3] } else { 0.0 },
+                    }
                 }));
             }
-            Ok(out)
+            pixels
         };
-        let (position, normal) = (read(&s.position)?, read(&s.normal)?);
         s.position.unmap();
         s.normal.unmap();
         s.state.store(IDLE, Ordering::Release);
-        let pixels = position
-            .iter()
-            .zip(&normal)
-            .map(|(p, n)| {
-                let id = p[3].round();
-                GPixel {
-                    position: Vec3::new(p[0], p[1], p[2]),
-                    material: (id >= 1.0).then(|| id as u32 - 1),
-                    normal: Vec3::new(n[0], n[1], n[2]),
-                    reflect: if id >= 1.0 { n[3] } else { 0.0 },
-                }
-            })
-            .collect();
         Ok(Some(GBufferImage { width: w, height: h, pixels }))
     }
 }

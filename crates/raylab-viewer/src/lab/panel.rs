@@ -339,7 +339,7 @@ fn dacrt_controls(ui: &mut egui::Ui, s: &mut ViewerSettings) {
     let d = &mut s.trace.dacrt;
     let max = DacrtParams::MAX_LEAF.min(256);
     ui.add(egui::Slider::new(&mut d.leaf_rays, 1..=max).logarithmic(true).text("leaf rays"))
-        .on_hover_text("a node with at most this many rays is tested naively");
+        .on_hover_text("a node with at most this many rays is tested naively (below the division made at setup)");
     ui.add(egui::Slider::new(&mut d.leaf_tris, 1..=max).logarithmic(true).text("leaf triangles"))
         .on_hover_text("a node with at most this many triangles is tested naively");
     egui::ComboBox::from_label("split").selected_text(d.split.name()).show_ui(ui, |ui| {
