@@ -40,9 +40,9 @@ use traverse::{Answer, Any, Blocker, Closest, Walk, beats};
 /// When DACRT stops dividing and how it divides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct DacrtParams {
-    /// A node with at most this many rays is tested naively, unless the setup already divided it (then its
-    /// division costs nothing, and following it filters the rays against boxes instead of testing them
-    /// against all of the node's triangles).
+    /// A node with at most this many rays is tested naively, unless the setup already divided it (calls with
+    /// the SAH rule: then its division costs nothing, and following it filters the rays against boxes instead
+    /// of testing them against all of the node's triangles).
     pub leaf_rays: usize,
     /// A node with at most this many triangles is tested naively.
     pub leaf_tris: usize,
