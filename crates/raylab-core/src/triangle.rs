@@ -57,6 +57,11 @@ impl RayShear {
         Self { origin: ray.origin, kx, ky, kz, sx: d[kx] * sz, sy: d[ky] * sz, sz }
     }
 
+    /// The ray's origin.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
     /// The axis the sheared ray runs along and the two others, in the order the edge functions use.
     pub fn axes(&self) -> [usize; 3] {
         [self.kx, self.ky, self.kz]
@@ -126,6 +131,14 @@ impl TriangleSoup {
     /// Copies the corners of every scene triangle.
     pub fn from_scene(scene: &Scene) -> Self {
         Self { verts: (0..scene.triangle_count()).map(|i| scene.vertices(i)).collect() }
+    }
+
+    /// Copies the corners of the scene triangles `ids`, in that order (a structure's leaf order, so a leaf's
+    /// triangles lie side by side). Ids past the scene's triangles (padding) get NaN corners, which no ray hits.
+    pub fn gather(scene: &Scene, ids: &[u32]) -> Self {
+        let n = scene.triangle_count();
+        let pad = [Vec3::NAN; 3];
+        Self { verts: ids.iter().map(|&i| if (i as usize) < n { scene.vertices(i as usize) } else { pad }).collect() }
     }
 
     /// The corners of triangle `i`.

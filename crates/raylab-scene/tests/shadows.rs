@@ -59,10 +59,12 @@ fn every_technique_gives_the_same_pixels_with_every_method() {
             let want = frame(&scene, &mono, &cam, light, shadows, 8);
             let lit = want.iter().filter(|p| p[0] > 40).count();
             assert!(lit > want.len() / 4, "{name} {shadows}: the frame is mostly dark ({lit} lit pixels)");
-            // Brute force and DACRT break ties between triangles hit at the same distance (coplanar faces of
-            // touching solids) by the lowest id, the tree's walks by the leaf they meet first: a pixel may show
-            // the other face's material, never a different distance.
-            let ties = |method| if method == Method::Dacrt { 2 } else { 0 };
+            // Triangles hit at exactly the same distance (coplanar faces of touching solids) are a tie: brute
+            // force and DACRT take the lowest id, the kd-tree's and the MBVH's walks the one they meet last in
+            // their own order, so methods off the kd-tree may show the other face's material in a pixel or two
+            // (the MBVH's hits equal the reference's up to such ties: tests/mbvh.rs), never a different
+            // distance.
+            let ties = |method| if matches!(method, Method::Dacrt | Method::Mbvh) { 2 } else { 0 };
             for method in COHERENT {
                 for tile in [4, 16] {
                     let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() })

@@ -1,5 +1,5 @@
-//! Building the 4-wide MBVH: a binary BVH by binned SAH over triangle centroids (16 bins on the widest
-//! centroid axis, the halves built in parallel with rayon), then collapsed top-down into 4-wide nodes by
+//! Building the 4-wide MBVH: a binary BVH by binned SAH over triangle centroids (16 bins on each of the three
+//! centroid axes, the halves built in parallel with rayon), then collapsed top-down into 4-wide nodes by
 //! repeatedly opening the child with the largest surface area (Wald et al. 2008, as the MBVH RS paper builds).
 
 use glam::Vec3;
@@ -36,6 +36,8 @@ impl Bin {
 /// The finished arrays: 4-wide nodes (the root first) and the triangle ids the leaves index.
 pub struct Built {
     pub nodes: Vec<MbvhNode>,
+    /// Each leaf's ids start at a multiple of four; the slots after a leaf up to the next multiple hold
+    /// [`EMPTY`], so a leaf is a whole number of four-triangle blocks.
     pub tri_ids: Vec<u32>,
     /// Nodes of the binary BVH before collapsing (for statistics).
     pub binary_nodes: usize,
@@ -59,7 +61,24 @@ pub fn build(boxes: &[Aabb], centroids: &[Vec3]) -> Built {
         }
         Bin::Inner { .. } => collapse(&root, 0, &mut nodes),
     }
-    Built { nodes, tri_ids: ids, binary_nodes: count }
+    let tri_ids = align_leaves(&mut nodes, &ids);
+    Built { nodes, tri_ids, binary_nodes: count }
+}
+
+/// Moves every leaf's ids (keeping the leaves' order) to a slot that is a multiple of four, padding with
+/// [`EMPTY`], and points the leaves at their new slots.
+fn align_leaves(nodes: &mut [MbvhNode], ids: &[u32]) -> Vec<u32> {
+    let mut leaves: Vec<(usize, usize)> =
+        (0..nodes.len()).flat_map(|i| (0..4).map(move |k| (i, k))).filter(|&(i, k)| nodes[i].is_leaf(k)).collect();
+    leaves.sort_unstable_by_key(|&(i, k)| nodes[i].child[k]);
+    let mut out = Vec::with_capacity(ids.len() + 3 * leaves.len());
+    for (i, k) in leaves {
+        let (first, count) = (nodes[i].child[k] as usize, nodes[i].count[k] as usize);
+        nodes[i].child[k] = out.len() as u32;
+        out.extend_from_slice(&ids[first..first + count]);
+        out.resize(out.len().next_multiple_of(4), EMPTY);
+    }
+    out
 }
 
 /// Relative padding of stored boxes: the slab test's rounding (a few ulps of the coordinates, amplified for
@@ -80,7 +99,6 @@ fn put(node: &mut MbvhNode, k: usize, b: &Aabb, first: u32, count: u32) {
     put_box(node, k, b);
     node.child[k] = first;
     node.count[k] = count;
-    node.used |= 1 << k;
 }
 
 /// Fills node `at` from binary inner node `n`: up to four grandchildren, opening the largest inner child
@@ -125,28 +143,17 @@ fn split(boxes: &[Aabb], centroids: &[Vec3], ids: &mut [u32], offset: u32, depth
         return leaf;
     }
     let cb = ids.iter().fold(Aabb::EMPTY, |b, &i| b.grow(centroids[i as usize]));
-    let extent = cb.extent();
-    let axis = if extent.x >= extent.y && extent.x >= extent.z {
-        0
-    } else if extent.y >= extent.z {
-        1
-    } else {
-        2
-    };
-    let (lo, width) = (cb.min[axis], extent[axis]);
     // Deep in the tree (lopsided SAH splits on pathological input), halve the list to bound the depth.
     let mid = if depth >= MAX_SAH_DEPTH {
         Some(n / 2)
-    } else if width > 0.0 && width.is_finite() {
-        best_split(boxes, centroids, ids, axis, lo, width, bounds).and_then(|(bin, cost)| {
+    } else {
+        best_split(boxes, centroids, ids, &cb, bounds).and_then(|split| {
             // Split when it beats a leaf, and always when the leaf would be too big.
-            (cost < n as f32 || n > MAX_LEAF).then(|| {
-                let scale = BINS as f32 / width;
-                partition(ids, |i| bin_of(centroids[i as usize][axis], lo, scale) <= bin)
+            (split.cost < n as f32 || n > MAX_LEAF).then(|| {
+                let (axis, lo, scale) = (split.axis, cb.min[split.axis], split.scale);
+                partition(ids, |i| bin_of(centroids[i as usize][axis], lo, scale) <= split.bin)
             })
         })
-    } else {
-        None
     };
     let mid = match mid {
         Some(m) if m > 0 && m < n => m,
@@ -175,46 +182,60 @@ fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
     (((c - lo) * scale) as usize).min(BINS - 1)
 }
 
-/// The bin after which to split (left = bins `0..=bin`) and its SAH cost, in units of triangle tests.
-fn best_split(
-    boxes: &[Aabb],
-    centroids: &[Vec3],
-    ids: &[u32],
+/// A binned split: left = bins `0..=bin` on `axis`, whose bins are `1 / scale` wide.
+struct Split {
     axis: usize,
-    lo: f32,
-    width: f32,
-    bounds: Aabb,
-) -> Option<(usize, f32)> {
-    let scale = BINS as f32 / width;
-    let mut bin_box = [Aabb::EMPTY; BINS];
-    let mut bin_n = [0u32; BINS];
-    for &i in ids {
-        let b = bin_of(centroids[i as usize][axis], lo, scale);
-        bin_box[b] = bin_box[b].union(boxes[i as usize]);
-        bin_n[b] += 1;
+    bin: usize,
+    scale: f32,
+    /// SAH cost in units of triangle tests.
+    cost: f32,
+}
+
+/// The cheapest binned split over all three centroid axes (axes where the centroids do not spread are
+/// skipped), or `None` when no axis separates them.
+fn best_split(boxes: &[Aabb], centroids: &[Vec3], ids: &[u32], cb: &Aabb, bounds: Aabb) -> Option<Split> {
+    let extent = cb.extent();
+    let scale: [f32; 3] = std::array::from_fn(|a| {
+        let s = BINS as f32 / extent[a];
+        if extent[a] > 0.0 && s.is_finite() { s } else { 0.0 }
+    });
+    if scale == [0.0; 3] {
+        return None;
     }
-    // Sweep from the right to get the right-side areas, then from the left.
-    let mut right_area = [0.0f32; BINS];
-    let mut right_n = [0u32; BINS];
-    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-    for b in (1..BINS).rev() {
-        acc = acc.union(bin_box[b]);
-        cnt += bin_n[b];
-        right_area[b] = acc.surface_area();
-        right_n[b] = cnt;
+    let mut bin_box = [[Aabb::EMPTY; BINS]; 3];
+    let mut bin_n = [[0u32; BINS]; 3];
+    for &i in ids {
+        let (c, b) = (centroids[i as usize], boxes[i as usize]);
+        for a in 0..3 {
+            let k = bin_of(c[a], cb.min[a], scale[a]);
+            bin_box[a][k] = bin_box[a][k].union(b);
+            bin_n[a][k] += 1;
+        }
     }
     let area = bounds.surface_area().max(f32::MIN_POSITIVE);
-    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-    let mut best: Option<(usize, f32)> = None;
-    for b in 0..BINS - 1 {
-        acc = acc.union(bin_box[b]);
-        cnt += bin_n[b];
-        if cnt == 0 || right_n[b + 1] == 0 {
-            continue;
+    let mut best: Option<Split> = None;
+    for a in (0..3).filter(|&a| scale[a] > 0.0) {
+        // Sweep from the right to get the right-side areas, then from the left.
+        let mut right_area = [0.0f32; BINS];
+        let mut right_n = [0u32; BINS];
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for b in (1..BINS).rev() {
+            acc = acc.union(bin_box[a][b]);
+            cnt += bin_n[a][b];
+            right_area[b] = acc.surface_area();
+            right_n[b] = cnt;
         }
-        let cost = C_TRAV + (acc.surface_area() * cnt as f32 + right_area[b + 1] * right_n[b + 1] as f32) / area;
-        if best.is_none_or(|(_, c)| cost < c) {
-            best = Some((b, cost));
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for b in 0..BINS - 1 {
+            acc = acc.union(bin_box[a][b]);
+            cnt += bin_n[a][b];
+            if cnt == 0 || right_n[b + 1] == 0 {
+                continue;
+            }
+            let cost = C_TRAV + (acc.surface_area() * cnt as f32 + right_area[b + 1] * right_n[b + 1] as f32) / area;
+            if best.as_ref().is_none_or(|s| cost < s.cost) {
+                best = Some(Split { axis: a, bin: b, scale: scale[a], cost });
+            }
         }
     }
     best

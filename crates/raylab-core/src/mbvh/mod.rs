@@ -6,9 +6,11 @@ mod node;
 mod refit;
 mod single;
 mod stream;
+mod tri4;
 
 pub use node::{EMPTY, MbvhNode};
 pub use refit::RefitError;
+use tri4::Tri4;
 
 use std::time::{Duration, Instant};
 
@@ -25,7 +27,13 @@ use crate::triangle::TriangleSoup;
 pub struct Mbvh {
     nodes: Vec<MbvhNode>,
     tri_ids: Vec<u32>,
+    /// The triangles in leaf order: `tris.get(s)` is scene triangle `tri_ids[s]`, so a leaf's corners are
+    /// contiguous and a test needs no indirection (padding slots hold NaN corners).
     tris: TriangleSoup,
+    /// The same triangles four to a block: block `b` holds slots `4b .. 4b + 4`.
+    blocks: Vec<Tri4>,
+    /// Inverse of `tri_ids`: the slot of each scene triangle.
+    slot_of: Vec<u32>,
     bounds: Aabb,
     build_time: Duration,
     binary_nodes: usize,
@@ -52,7 +60,7 @@ pub struct MbvhStats {
     pub avg_tris_per_leaf: f64,
     /// Deepest level of 4-wide nodes (the root is 1).
     pub depth: usize,
-    /// Bytes of nodes and triangle ids.
+    /// Bytes of nodes, triangle ids and four-triangle blocks.
     pub bytes: usize,
 }
 
@@ -60,12 +68,14 @@ impl Mbvh {
     /// Builds the MBVH of `scene` on the current rayon pool.
     pub fn build(scene: &Scene) -> Self {
         let start = Instant::now();
-        let tris = TriangleSoup::from_scene(scene);
-        let boxes: Vec<Aabb> = tris.as_slice().iter().map(|t| Aabb::from_points(*t)).collect();
+        let boxes: Vec<Aabb> = (0..scene.triangle_count()).map(|i| Aabb::from_points(scene.vertices(i))).collect();
         let centroids: Vec<Vec3> = boxes.iter().map(Aabb::center).collect();
         let built = build::build(&boxes, &centroids);
         let depth = depth_of(&built.nodes);
+        let tris = TriangleSoup::gather(scene, &built.tri_ids);
         Self {
+            blocks: blocks_of(&tris),
+            slot_of: inverse(&built.tri_ids, scene.triangle_count()),
             nodes: built.nodes,
             tri_ids: built.tri_ids,
             bounds: scene.bounds(),
@@ -82,12 +92,13 @@ impl Mbvh {
         &self.nodes
     }
 
-    /// Triangle ids indexed by leaves.
+    /// Triangle ids indexed by leaves; each leaf starts at a multiple of four, and the padding slots after a
+    /// leaf hold [`EMPTY`].
     pub fn tri_ids(&self) -> &[u32] {
         &self.tri_ids
     }
 
-    /// The triangles.
+    /// The triangles in leaf order (slot `s` holds scene triangle `tri_ids()[s]`).
     pub fn triangles(&self) -> &TriangleSoup {
         &self.tris
     }
@@ -124,9 +135,25 @@ impl Mbvh {
             lane_fill_percent: 100.0 * used as f64 / (4 * self.nodes.len()).max(1) as f64,
             avg_tris_per_leaf: tris as f64 / leaves.max(1) as f64,
             depth: self.depth,
-            bytes: self.nodes.len() * std::mem::size_of::<MbvhNode>() + self.tri_ids.len() * 4,
+            bytes: self.nodes.len() * std::mem::size_of::<MbvhNode>()
+                + self.tri_ids.len() * 4
+                + self.blocks.len() * std::mem::size_of::<Tri4>(),
         }
     }
+}
+
+/// The slot of each of the `n` triangles in the padded leaf order `ids`.
+fn inverse(ids: &[u32], n: usize) -> Vec<u32> {
+    let mut slot_of = vec![0u32; n];
+    for (slot, &id) in ids.iter().enumerate().filter(|(_, id)| **id != EMPTY) {
+        slot_of[id as usize] = slot as u32;
+    }
+    slot_of
+}
+
+/// Four-triangle blocks of a padded leaf-order soup (its length is a multiple of four).
+fn blocks_of(tris: &TriangleSoup) -> Vec<Tri4> {
+    tris.as_slice().chunks(4).map(Tri4::pack).collect()
 }
 
 /// Levels of 4-wide nodes below and including the root.

@@ -4,7 +4,10 @@
 /// Marks an empty lane in [`MbvhNode::child`].
 pub const EMPTY: u32 = u32::MAX;
 
-/// One 4-wide node (two cache lines).
+/// One 4-wide node: 128 bytes, two cache lines.
+///
+/// An empty lane's inverted box (`+inf` below, `-inf` above) fails every slab test, whatever the ray, so the
+/// kernels need no separate mask of used lanes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub struct MbvhNode {
@@ -16,20 +19,14 @@ pub struct MbvhNode {
     pub child: [u32; 4],
     /// Per lane: the leaf's triangle count, 0 for an inner child or an empty lane.
     pub count: [u32; 4],
-    /// Bit `k` set when lane `k` holds a child.
-    pub used: u32,
 }
+
+const _: () = assert!(std::mem::size_of::<MbvhNode>() == 128);
 
 impl MbvhNode {
     /// A node with four empty lanes.
     pub const fn empty() -> Self {
-        Self {
-            min: [[f32::INFINITY; 4]; 3],
-            max: [[f32::NEG_INFINITY; 4]; 3],
-            child: [EMPTY; 4],
-            count: [0; 4],
-            used: 0,
-        }
+        Self { min: [[f32::INFINITY; 4]; 3], max: [[f32::NEG_INFINITY; 4]; 3], child: [EMPTY; 4], count: [0; 4] }
     }
 
     /// True when lane `k` holds a leaf.

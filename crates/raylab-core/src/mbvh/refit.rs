@@ -32,11 +32,12 @@ impl Mbvh {
     /// Recomputes every box for the current positions of `scene`'s triangles, which must be the ones the MBVH
     /// was built over (same count and ids). Returns how long it took.
     pub fn refit(&mut self, scene: &Scene) -> Result<Duration, RefitError> {
-        if scene.triangle_count() != self.tris.len() {
-            return Err(RefitError { built: self.tris.len(), now: scene.triangle_count() });
+        if scene.triangle_count() != self.slot_of.len() {
+            return Err(RefitError { built: self.slot_of.len(), now: scene.triangle_count() });
         }
         let start = Instant::now();
-        self.tris = TriangleSoup::from_scene(scene);
+        self.tris = TriangleSoup::gather(scene, &self.tri_ids);
+        self.blocks = super::blocks_of(&self.tris);
         let mut node_box = vec![Aabb::EMPTY; self.nodes.len()];
         for i in (0..self.nodes.len()).rev() {
             let mut total = Aabb::EMPTY;
@@ -47,9 +48,8 @@ impl Mbvh {
                 }
                 let (child, count) = (node.child[k] as usize, node.count[k] as usize);
                 let b = if node.is_leaf(k) {
-                    self.tri_ids[child..child + count]
-                        .iter()
-                        .fold(Aabb::EMPTY, |b, &t| b.union(Aabb::from_points(*self.tris.get(t))))
+                    (child..child + count)
+                        .fold(Aabb::EMPTY, |b, s| b.union(Aabb::from_points(*self.tris.get(s as u32))))
                 } else {
                     node_box[child]
                 };

@@ -1,15 +1,20 @@
 //! Single-ray MBVH traversal (MBVH RS paper, section 3.1): one ray against the four boxes of a node at once,
-//! hit children visited nearest first, leaves' triangles tested one by one with the watertight test.
+//! hit children visited nearest first, leaves' triangles tested four at a time with the watertight test
+//! ([`super::tri4`]). A node with one hit child hands it straight on and two are ordered with one comparison;
+//! only three or four go through a small sort on the stack.
 //!
 //! The slab test takes each axis's entry and exit in the order the direction's sign gives and merges them with
 //! comparisons that ignore NaN, so a zero direction component (infinite inverse) with the origin on a slab's
 //! plane (`0 * inf = NaN`) leaves that axis unconstrained, as it should: the ray runs inside the plane. The far
 //! distance is widened by a few ulps, so rounding never culls a box a ray grazes.
 
+use std::ops::Range;
+
 use raylab_simd::{VMask, Vf32};
 
 use super::Mbvh;
 use super::node::MbvhNode;
+use super::tri4::ShearX4;
 use crate::ray::{Hit, Ray};
 use crate::stats::TraversalStats;
 use crate::triangle::RayShear;
@@ -43,9 +48,9 @@ impl<V: Vf32> RaySlab<V> {
             let (first, second) = if self.pos[a] { (&node.min[a], &node.max[a]) } else { (&node.max[a], &node.min[a]) };
             let enter = (V::from_slice(first) - self.org[a]) * self.inv[a];
             let leave = (V::from_slice(second) - self.org[a]) * self.inv[a];
-            // A NaN (origin on the plane, zero direction) fails both comparisons and changes nothing.
-            near = V::select(enter.gt(near), enter, near);
-            far = V::select(leave.lt(far), leave, far);
+            // SSE rule: a NaN `enter`/`leave` (origin on the plane, zero direction) keeps the other operand.
+            near = enter.max(near);
+            far = leave.min(far);
         }
         (near, near.le(far * V::splat(FAR_SLACK)))
     }
@@ -92,16 +97,24 @@ impl Mbvh {
     }
 
     fn intersect_with<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        let shear = RayShear::new(ray);
+        let shear = ShearX4::<V>::new(&RayShear::new(ray));
         let mut best: Option<Hit> = None;
         let mut best_t = ray.tmax;
         let mut tests = 0u64;
-        let mut leaf = |ids: &[u32], limit: &mut f32| {
-            for &id in ids {
-                tests += 1;
-                if let Some(h) = shear.intersect(self.tris.get(id), ray.tmin, best_t) {
-                    best_t = h.t;
-                    best = Some(Hit { t: h.t, tri: id, u: h.u, v: h.v });
+        let mut leaf = |slots: Range<usize>, limit: &mut f32| {
+            tests += slots.len() as u64;
+            for b in slots.start / 4..slots.end.div_ceil(4) {
+                let h = shear.test(&self.blocks[b], ray.tmin, best_t);
+                let mut bits = h.mask.bits();
+                // Later lanes win ties, as when the triangles are tested one by one.
+                while bits != 0 {
+                    let lane = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let t = h.t.lane(lane);
+                    if t <= best_t {
+                        best_t = t;
+                        best = Some(Hit { t, tri: self.tri_ids[4 * b + lane], u: h.u.lane(lane), v: h.v.lane(lane) });
+                    }
                 }
             }
             *limit = best_t;
@@ -115,8 +128,8 @@ impl Mbvh {
     /// True when triangle `tri` blocks `ray` (the shadow cache's test).
     pub fn blocks(&self, ray: &Ray, tri: u32) -> bool {
         ray.is_valid()
-            && (tri as usize) < self.tris.len()
-            && RayShear::new(ray).intersect(self.tris.get(tri), ray.tmin, ray.tmax).is_some()
+            && (tri as usize) < self.slot_of.len()
+            && RayShear::new(ray).intersect(self.tris.get(self.slot_of[tri as usize]), ray.tmin, ray.tmax).is_some()
     }
 
     /// The first blocker found along `ray` (not necessarily the nearest), for the shadow cache.
@@ -135,14 +148,15 @@ impl Mbvh {
     }
 
     fn occluder_with<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
-        let shear = RayShear::new(ray);
+        let shear = ShearX4::<V>::new(&RayShear::new(ray));
         let mut blocker = None;
         let mut tests = 0u64;
-        let mut leaf = |ids: &[u32], _: &mut f32| {
-            for &id in ids {
-                tests += 1;
-                if shear.intersect(self.tris.get(id), ray.tmin, ray.tmax).is_some() {
-                    blocker = Some(id);
+        let mut leaf = |slots: Range<usize>, _: &mut f32| {
+            for b in slots.start / 4..slots.end.div_ceil(4) {
+                tests += (slots.end - 4 * b).min(4) as u64;
+                let bits = shear.test(&self.blocks[b], ray.tmin, ray.tmax).mask.bits();
+                if bits != 0 {
+                    blocker = Some(self.tri_ids[4 * b + bits.trailing_zeros() as usize]);
                     return true;
                 }
             }
@@ -159,7 +173,7 @@ impl Mbvh {
         &self,
         ray: &Ray,
         stats: &mut TraversalStats,
-        leaf: &mut impl FnMut(&[u32], &mut f32) -> bool,
+        leaf: &mut impl FnMut(Range<usize>, &mut f32) -> bool,
     ) {
         if self.depth <= SHALLOW_DEPTH {
             self.walk::<V, SHALLOW_STACK>(ray, stats, leaf);
@@ -168,14 +182,15 @@ impl Mbvh {
         }
     }
 
-    /// Walks the leaves `ray` reaches, nearest child first; `leaf(ids, limit)` tests a leaf's triangles,
+    /// Walks the leaves `ray` reaches, nearest child first; `leaf(slots, limit)` tests a leaf's triangles
+    /// (positions in `tri_ids` and in the leaf-ordered triangles),
     /// may lower `limit` (the farthest distance still of interest), and returns true to stop.
     #[inline(always)]
     fn walk<V: Vf32, const STACK: usize>(
         &self,
         ray: &Ray,
         stats: &mut TraversalStats,
-        leaf: &mut impl FnMut(&[u32], &mut f32) -> bool,
+        leaf: &mut impl FnMut(Range<usize>, &mut f32) -> bool,
     ) {
         stats.rays += 1;
         stats.packets += 1;
@@ -186,62 +201,76 @@ impl Mbvh {
         let mut limit = ray.tmax;
         let mut stack = [Entry::default(); STACK];
         let mut sp = 0usize;
-        let (mut boxes, mut nodes, mut leaves) = (0u64, 0u64, 0u64);
-        let mut node = 0usize;
+        let (mut nodes, mut leaves) = (0u64, 0u64);
+        let mut cur = Entry { child: 0, count: 0, near: ray.tmin };
         'walk: loop {
-            // Inner node: test the box packet, push hit children far to near, continue with the nearest.
-            nodes += 1;
-            boxes += 1;
-            let n = &self.nodes[node];
-            let (near, mask) = slab.test(n, ray.tmin, limit);
-            let bits = mask.bits() & n.used;
-            let mut dist = [0f32; 4];
-            near.write_to(&mut dist);
-            let mut hits: [(f32, u32); 4] = [(0.0, 0); 4];
-            let mut k = 0;
-            for (lane, &d) in dist.iter().enumerate() {
-                if bits >> lane & 1 == 1 {
-                    hits[k] = (d, lane as u32);
-                    k += 1;
+            if cur.count == 0 {
+                // Inner node: test its box packet. One hit child is entered directly, two are ordered with one
+                // comparison, three or four are pushed and sorted on the stack; the nearest is entered next.
+                nodes += 1;
+                let n = &self.nodes[cur.child as usize];
+                let (near, mask) = slab.test(n, ray.tmin, limit);
+                let mut bits = mask.bits();
+                if bits != 0 {
+                    let mut dist = [0f32; 4];
+                    near.write_to(&mut dist);
+                    let entry = |k: usize| Entry { child: n.child[k], count: n.count[k], near: dist[k] };
+                    let a = entry(bits.trailing_zeros() as usize);
+                    bits &= bits - 1;
+                    if bits == 0 {
+                        cur = a;
+                        continue;
+                    }
+                    let b = entry(bits.trailing_zeros() as usize);
+                    bits &= bits - 1;
+                    let (first, second) = if b.near < a.near { (b, a) } else { (a, b) };
+                    if bits == 0 {
+                        stack[sp] = second;
+                        sp += 1;
+                        cur = first;
+                        continue;
+                    }
+                    // Three or four: push them and insertion-sort the new entries, farthest deepest.
+                    let base = sp;
+                    stack[sp] = second;
+                    stack[sp + 1] = first;
+                    sp += 2;
+                    while bits != 0 {
+                        let mut j = sp;
+                        stack[j] = entry(bits.trailing_zeros() as usize);
+                        bits &= bits - 1;
+                        while j > base && stack[j - 1].near < stack[j].near {
+                            stack.swap(j - 1, j);
+                            j -= 1;
+                        }
+                        sp += 1;
+                    }
+                    sp -= 1;
+                    cur = stack[sp];
+                    continue;
+                }
+            } else {
+                leaves += 1;
+                let slots = cur.child as usize..(cur.child + cur.count) as usize;
+                if leaf(slots, &mut limit) {
+                    break 'walk;
                 }
             }
-            // Nearest last (popped first): a small insertion sort by distance, descending.
-            for i in 1..k {
-                let mut j = i;
-                while j > 0 && hits[j - 1].0 < hits[j].0 {
-                    hits.swap(j - 1, j);
-                    j -= 1;
-                }
-            }
-            for &(t, lane) in &hits[..k] {
-                let lane = lane as usize;
-                stack[sp] = Entry { child: n.child[lane], count: n.count[lane], near: t };
-                sp += 1;
-            }
-            // Pop until an inner node comes up; leaves on the way are tested.
+            // Pop the nearest pending child that may still hold something closer than the best hit.
             loop {
                 if sp == 0 {
                     break 'walk;
                 }
                 sp -= 1;
-                let e = stack[sp];
-                if e.near > limit {
-                    continue;
-                }
-                if e.count == 0 {
-                    node = e.child as usize;
-                    continue 'walk;
-                }
-                leaves += 1;
-                let ids = &self.tri_ids[e.child as usize..(e.child + e.count) as usize];
-                if leaf(ids, &mut limit) {
-                    break 'walk;
+                cur = stack[sp];
+                if cur.near <= limit {
+                    break;
                 }
             }
         }
         stats.nodes += nodes;
         stats.leaves += leaves;
-        stats.box_tests += boxes;
+        stats.box_tests += nodes;
     }
 }
 
@@ -268,12 +297,16 @@ mod tests {
             let ray = Ray::new(Vec3::new(a.sin() * 3.0 + 8.0, a.cos() * 4.0 + 9.0, 5.0), Vec3::new(0.1, -0.05, -1.0));
             let mut leaves = (Vec::new(), Vec::new());
             let mut s = TraversalStats::default();
-            m.walk::<raylab_simd::scalar::F32x4, SHALLOW_STACK>(&ray, &mut s, &mut |ids: &[u32], _: &mut f32| {
-                leaves.0.push(ids[0]);
-                false
-            });
-            m.walk::<raylab_simd::scalar::F32x4, DEEP_STACK>(&ray, &mut s, &mut |ids: &[u32], _: &mut f32| {
-                leaves.1.push(ids[0]);
+            m.walk::<raylab_simd::scalar::F32x4, SHALLOW_STACK>(
+                &ray,
+                &mut s,
+                &mut |slots: Range<usize>, _: &mut f32| {
+                    leaves.0.push(slots.start);
+                    false
+                },
+            );
+            m.walk::<raylab_simd::scalar::F32x4, DEEP_STACK>(&ray, &mut s, &mut |slots: Range<usize>, _: &mut f32| {
+                leaves.1.push(slots.start);
                 false
             });
             assert_eq!(leaves.0, leaves.1);

@@ -6,6 +6,8 @@
 //! active rays are packed four at a time into temporary SoA packets and tested against one triangle per step.
 //! Shadow rays leave the stream at their first hit.
 
+use std::ops::Range;
+
 use raylab_simd::{VMask, Vf32};
 
 use super::Mbvh;
@@ -124,9 +126,9 @@ impl Mbvh {
                 slots4 += c.div_ceil(4) * 4;
                 slots8 += c.div_ceil(8) * 8;
                 slots16 += c.div_ceil(16) * 16;
-                let tri_ids = &self.tri_ids[task.child as usize..(task.child + task.tris) as usize];
+                let tri_slots = task.child as usize..(task.child + task.tris) as usize;
                 for group in current.chunks(4) {
-                    tests += self.leaf_packet(slots, group, tri_ids, shadow);
+                    tests += self.leaf_packet(slots, group, tri_slots.clone(), shadow);
                 }
                 continue;
             }
@@ -139,15 +141,13 @@ impl Mbvh {
                 }
             }
             let mut lengths = V::splat(0.0);
-            let used = V::Mask::from_bits(node.used);
             for &id in &current {
                 let s = &slots[id as usize];
                 if s.blocked {
                     continue;
                 }
                 box_tests += 1;
-                let (near, mask) = s.slab.test(node, s.ray.tmin, s.best);
-                let hit = mask & used;
+                let (near, hit) = s.slab.test(node, s.ray.tmin, s.best);
                 lengths = lengths + V::select(hit, near, V::splat(0.0));
                 let bits = hit.bits();
                 for (k, stack) in lanes.iter_mut().enumerate() {
@@ -190,7 +190,7 @@ impl Mbvh {
 
     /// Tests up to four rays, packed into a temporary SoA packet, against the leaf's triangles; returns the
     /// number of packet/triangle tests.
-    fn leaf_packet<V: Vf32>(&self, slots: &mut [Slot<V>], group: &[u32], tri_ids: &[u32], shadow: bool) -> u64 {
+    fn leaf_packet<V: Vf32>(&self, slots: &mut [Slot<V>], group: &[u32], tri_slots: Range<usize>, shadow: bool) -> u64 {
         let mut rays = [None; 4];
         for (r, &id) in rays.iter_mut().zip(group) {
             let s = &slots[id as usize];
@@ -200,9 +200,9 @@ impl Mbvh {
         let mut tests = 0;
         if shadow {
             let mut open = p.valid;
-            for &tri in tri_ids {
+            for slot in tri_slots {
                 tests += 1;
-                open = open & !occlude_packet(&p, self.tris.get(tri), open);
+                open = open & !occlude_packet(&p, self.tris.get(slot as u32), open);
                 if open.none() {
                     break;
                 }
@@ -215,9 +215,9 @@ impl Mbvh {
             }
         } else {
             let mut hits = PacketHits::new(&p);
-            for &tri in tri_ids {
+            for slot in tri_slots {
                 tests += 1;
-                intersect_packet(&p, &mut hits, self.tris.get(tri), tri, p.valid);
+                intersect_packet(&p, &mut hits, self.tris.get(slot as u32), self.tri_ids[slot], p.valid);
             }
             let found = hits.to_hits();
             for (k, &id) in group.iter().enumerate() {

@@ -1,0 +1,179 @@
+//! Leaf triangles four at a time: one ray against a block of four triangles stored side by side (structure of
+//! arrays), with the watertight test (Woop, Benthin, Wald 2013) run in the four SIMD lanes.
+//!
+//! The MBVH RS paper's leaves test four rays against one triangle (`crate::packet`); a single ray has no
+//! rays to fill the lanes with, so single-ray MBVH traversal fills them with triangles instead, as Embree's
+//! four-triangle leaves do. Every lane performs exactly the `f32` operations of
+//! [`RayShear::intersect`], in the same order, and lanes whose edge functions are exactly zero are redone by
+//! that scalar test (its double-precision fallback), so a block reports bit for bit what testing its
+//! triangles one by one reports. Unused lanes hold NaN corners, which fail every comparison and never hit.
+
+use glam::Vec3;
+use raylab_simd::{VMask, Vf32};
+
+use crate::triangle::{RayShear, TriHit};
+
+/// Four triangles' corners in structure-of-arrays form: `v[corner][axis][lane]`.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct Tri4 {
+    v: [[[f32; 4]; 3]; 3],
+}
+
+impl Tri4 {
+    /// Packs up to four triangles; missing lanes get NaN corners.
+    pub fn pack(tris: &[[Vec3; 3]]) -> Self {
+        assert!(tris.len() <= 4, "a block holds at most four triangles");
+        let mut v = [[[f32::NAN; 4]; 3]; 3];
+        for (lane, tri) in tris.iter().enumerate() {
+            for (corner, p) in tri.iter().enumerate() {
+                for axis in 0..3 {
+                    v[corner][axis][lane] = p[axis];
+                }
+            }
+        }
+        Self { v }
+    }
+
+    /// The corners of lane `lane`'s triangle.
+    pub fn triangle(&self, lane: usize) -> [Vec3; 3] {
+        std::array::from_fn(|c| Vec3::new(self.v[c][0][lane], self.v[c][1][lane], self.v[c][2][lane]))
+    }
+}
+
+/// A ray's watertight-test constants splatted across the lanes.
+pub struct ShearX4<V: Vf32> {
+    scalar: RayShear,
+    /// Origin components in the shear's `(kx, ky, kz)` order.
+    org: [V; 3],
+    /// `(S_x, S_y, S_z)`.
+    s: [V; 3],
+    /// `(kx, ky, kz)`.
+    k: [usize; 3],
+}
+
+/// The lanes of a block a ray hits, with their distances and barycentrics.
+pub struct BlockHits<V: Vf32> {
+    /// Lanes hit within the interval.
+    pub mask: V::Mask,
+    /// Distances (meaningful in `mask`'s lanes).
+    pub t: V,
+    /// Weights of corner 1.
+    pub u: V,
+    /// Weights of corner 2.
+    pub v: V,
+}
+
+impl<V: Vf32> ShearX4<V> {
+    /// Splats `shear`'s constants.
+    pub fn new(shear: &RayShear) -> Self {
+        let k = shear.axes();
+        let o = shear.origin();
+        let s = shear.shear();
+        Self { scalar: *shear, org: k.map(|a| V::splat(o[a])), s: s.map(V::splat), k }
+    }
+
+    /// Corner `c` of every lane relative to the origin, in `(kx, ky, kz)` order.
+    #[inline(always)]
+    fn corner(&self, b: &Tri4, c: usize) -> (V, V, V) {
+        let [kx, ky, kz] = self.k;
+        (
+            V::from_slice(&b.v[c][kx]) - self.org[0],
+            V::from_slice(&b.v[c][ky]) - self.org[1],
+            V::from_slice(&b.v[c][kz]) - self.org[2],
+        )
+    }
+
+    /// Tests the four triangles of `b`, reporting hits with `tmin < t <= tmax` as [`RayShear::intersect`].
+    #[inline(always)]
+    pub fn test(&self, b: &Tri4, tmin: f32, tmax: f32) -> BlockHits<V> {
+        let [sx, sy, sz] = self.s;
+        let (a_x, a_y, a_z) = self.corner(b, 0);
+        let (b_x, b_y, b_z) = self.corner(b, 1);
+        let (c_x, c_y, c_z) = self.corner(b, 2);
+        let ax = a_x - sx * a_z;
+        let ay = a_y - sy * a_z;
+        let bx = b_x - sx * b_z;
+        let by = b_y - sy * b_z;
+        let cx = c_x - sx * c_z;
+        let cy = c_y - sy * c_z;
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let zero = V::splat(0.0);
+        let exact_zero = u.eq(zero) | v.eq(zero) | w.eq(zero);
+        let neg = u.lt(zero) | v.lt(zero) | w.lt(zero);
+        let pos = u.gt(zero) | v.gt(zero) | w.gt(zero);
+        let det = u + v + w;
+        let t_scaled = u * (sz * a_z) + v * (sz * b_z) + w * (sz * c_z);
+        let abs_det = det.abs();
+        let t_signed = V::select(det.lt(zero), zero - t_scaled, t_scaled);
+        let (vmin, vmax) = (V::splat(tmin), V::splat(tmax));
+        let inside = t_signed.gt(vmin * abs_det) & t_signed.le(vmax * abs_det);
+        let inv = V::splat(1.0) / det;
+        let t = t_scaled * inv;
+        let in_range = t.gt(vmin) & t.le(vmax);
+        let mask = !exact_zero & !(neg & pos) & !det.eq(zero) & inside & in_range;
+        let hits = BlockHits { mask, t, u: v * inv, v: w * inv };
+        if exact_zero.none() { hits } else { self.redo(b, hits, exact_zero.bits(), tmin, tmax) }
+    }
+
+    /// Rare: lanes with an exactly zero edge function, which the scalar test decides in double precision.
+    #[cold]
+    fn redo(&self, b: &Tri4, hits: BlockHits<V>, lanes: u32, tmin: f32, tmax: f32) -> BlockHits<V> {
+        let (mut t, mut u, mut v) = ([0f32; 4], [0f32; 4], [0f32; 4]);
+        hits.t.write_to(&mut t);
+        hits.u.write_to(&mut u);
+        hits.v.write_to(&mut v);
+        let mut bits = hits.mask.bits();
+        for lane in (0..4).filter(|i| lanes >> i & 1 == 1) {
+            if let Some(TriHit { t: ht, u: hu, v: hv }) = self.scalar.intersect(&b.triangle(lane), tmin, tmax) {
+                (t[lane], u[lane], v[lane]) = (ht, hu, hv);
+                bits |= 1 << lane;
+            }
+        }
+        BlockHits { mask: V::Mask::from_bits(bits), t: V::from_slice(&t), u: V::from_slice(&u), v: V::from_slice(&v) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ray::Ray;
+
+    /// Lanes of a block report bit for bit what the scalar test reports, exact-zero edges included.
+    fn lanes<V: Vf32>() {
+        let tris = [
+            [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            [Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            [Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 1.0, 0.5), Vec3::new(1.0, 0.0, 0.5)],
+        ];
+        let block = Tri4::pack(&tris);
+        let rays = [
+            Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0)),
+            // Through the shared edge (exact zero edge functions).
+            Ray::new(Vec3::new(0.5, 0.5, -2.0), Vec3::new(0.0, 0.0, 1.0)),
+            Ray::new(Vec3::new(-1.0, 0.3, 0.25), Vec3::new(1.2, 0.0, 0.1)),
+            Ray::new(Vec3::new(0.2, 0.2, 0.0), Vec3::X),
+            Ray::new(Vec3::new(0.0, 0.0, 3.0), Vec3::new(0.0, 0.0, -1.0)),
+        ];
+        for ray in rays {
+            let shear = RayShear::new(&ray);
+            let got = ShearX4::<V>::new(&shear).test(&block, ray.tmin, ray.tmax);
+            let bits = got.mask.bits();
+            assert_eq!(bits & 8, 0, "the empty lane never hits");
+            for (lane, tri) in tris.iter().enumerate() {
+                let want = shear.intersect(tri, ray.tmin, ray.tmax).map(|h| (h.t, h.u, h.v));
+                let have = (bits >> lane & 1 == 1).then(|| (got.t.lane(lane), got.u.lane(lane), got.v.lane(lane)));
+                assert_eq!(have, want, "ray {ray:?} lane {lane}");
+            }
+        }
+    }
+
+    #[test]
+    fn block_lanes_equal_the_scalar_test() {
+        lanes::<raylab_simd::scalar::F32x4>();
+        #[cfg(target_arch = "x86_64")]
+        lanes::<raylab_simd::sse::F32x4>();
+    }
+}
