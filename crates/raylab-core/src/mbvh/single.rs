@@ -31,12 +31,13 @@ pub(super) struct RaySlab<V: Vf32> {
 
 impl<V: Vf32> RaySlab<V> {
     pub(super) fn new(ray: &Ray) -> Self {
-        let (o, inv) = (ray.origin, ray.inv_dir());
-        Self {
-            org: [V::splat(o.x), V::splat(o.y), V::splat(o.z)],
-            inv: [V::splat(inv.x), V::splat(inv.y), V::splat(inv.z)],
-            pos: [inv.x, inv.y, inv.z].map(|i| i.is_sign_positive()),
-        }
+        Self::from_parts(ray.origin.to_array(), ray.inv_dir().to_array())
+    }
+
+    /// From a ray's origin and inverse direction.
+    #[inline(always)]
+    pub(super) fn from_parts(org: [f32; 3], inv: [f32; 3]) -> Self {
+        Self { org: org.map(V::splat), inv: inv.map(V::splat), pos: inv.map(|i| i.is_sign_positive()) }
     }
 
     /// Entry distances of the four boxes of `node` and the mask of those entered within `[t_min, t_max]`.
@@ -87,13 +88,7 @@ impl Mbvh {
 
     /// True when anything blocks `ray` in `(tmin, tmax]`.
     pub fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        match self.backend {
-            #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
-                self.occluded_with::<raylab_simd::sse::F32x4>(ray, stats)
-            }
-            _ => self.occluded_with::<raylab_simd::scalar::F32x4>(ray, stats),
-        }
+        self.occluder(ray, stats).is_some()
     }
 
     fn intersect_with<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
@@ -103,26 +98,60 @@ impl Mbvh {
         let mut tests = 0u64;
         let mut leaf = |slots: Range<usize>, limit: &mut f32| {
             tests += slots.len() as u64;
-            for b in slots.start / 4..slots.end.div_ceil(4) {
-                let h = shear.test(&self.blocks[b], ray.tmin, best_t);
-                let mut bits = h.mask.bits();
-                // Later lanes win ties, as when the triangles are tested one by one.
-                while bits != 0 {
-                    let lane = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    let t = h.t.lane(lane);
-                    if t <= best_t {
-                        best_t = t;
-                        best = Some(Hit { t, tri: self.tri_ids[4 * b + lane], u: h.u.lane(lane), v: h.v.lane(lane) });
-                    }
-                }
-            }
+            self.closest_in_leaf(&shear, slots, ray.tmin, &mut best_t, &mut best);
             *limit = best_t;
             false
         };
         self.walk_sized::<V>(ray, stats, &mut leaf);
         stats.isect_tests += tests;
         best
+    }
+
+    /// Tests the triangles in `slots` (a leaf, four to a block) and keeps a closer hit in `best`, lowering
+    /// `best_t` to it. Later lanes win ties, as when the triangles are tested one by one.
+    #[inline(always)]
+    pub(super) fn closest_in_leaf<V: Vf32>(
+        &self,
+        shear: &ShearX4<V>,
+        slots: Range<usize>,
+        tmin: f32,
+        best_t: &mut f32,
+        best: &mut Option<Hit>,
+    ) {
+        for b in slots.start / 4..slots.end.div_ceil(4) {
+            let h = shear.test(&self.blocks[b], tmin, *best_t);
+            let mut bits = h.mask.bits();
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let t = h.t.lane(lane);
+                if t <= *best_t {
+                    *best_t = t;
+                    *best = Some(Hit { t, tri: self.tri_ids[4 * b + lane], u: h.u.lane(lane), v: h.v.lane(lane) });
+                }
+            }
+        }
+    }
+
+    /// The first triangle in `slots` (a leaf, four to a block) found to block `(tmin, tmax]`, and the number
+    /// of triangles tested until then.
+    #[inline(always)]
+    pub(super) fn blocker_in_leaf<V: Vf32>(
+        &self,
+        shear: &ShearX4<V>,
+        slots: Range<usize>,
+        tmin: f32,
+        tmax: f32,
+    ) -> (Option<u32>, u64) {
+        let mut tests = 0;
+        for b in slots.start / 4..slots.end.div_ceil(4) {
+            tests += (slots.end - 4 * b).min(4) as u64;
+            let bits = shear.test(&self.blocks[b], tmin, tmax).mask.bits();
+            if bits != 0 {
+                return (Some(self.tri_ids[4 * b + bits.trailing_zeros() as usize]), tests);
+            }
+        }
+        (None, tests)
     }
 
     /// True when triangle `tri` blocks `ray` (the shadow cache's test).
@@ -143,24 +172,15 @@ impl Mbvh {
         }
     }
 
-    fn occluded_with<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        self.occluder_with::<V>(ray, stats).is_some()
-    }
-
     fn occluder_with<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         let shear = ShearX4::<V>::new(&RayShear::new(ray));
         let mut blocker = None;
         let mut tests = 0u64;
         let mut leaf = |slots: Range<usize>, _: &mut f32| {
-            for b in slots.start / 4..slots.end.div_ceil(4) {
-                tests += (slots.end - 4 * b).min(4) as u64;
-                let bits = shear.test(&self.blocks[b], ray.tmin, ray.tmax).mask.bits();
-                if bits != 0 {
-                    blocker = Some(self.tri_ids[4 * b + bits.trailing_zeros() as usize]);
-                    return true;
-                }
-            }
-            false
+            let (found, n) = self.blocker_in_leaf(&shear, slots, ray.tmin, ray.tmax);
+            tests += n;
+            blocker = found;
+            found.is_some()
         };
         self.walk_sized::<V>(ray, stats, &mut leaf);
         stats.isect_tests += tests;

@@ -3,8 +3,14 @@
 //! `lane`'s active-ray stack reached `node`. Every such ray is tested against the node's four boxes at once and
 //! its id pushed onto the stack of each lane it hits; tasks for the children then go on the task stack,
 //! ordered by the hit distances accumulated per lane (nearest last, so it is walked first). At a leaf the
-//! active rays are packed four at a time into temporary SoA packets and tested against one triangle per step.
+//! active rays are packed four at a time into temporary SoA packets and tested against one triangle per step;
+//! one or two rays left over after the whole packets test the leaf's triangles four at a time instead (the
+//! single-ray leaf test), since a packet of them would leave most lanes idle. The leaf counters (Figure 6's
+//! primitive tests) count SIMD tests either way: packet against triangle, or ray against four triangles.
 //! Shadow rays leave the stream at their first hit.
+//!
+//! What the box tests read of each ray (origin, inverse direction, `tmin`, current limit) lives in a 32-byte
+//! record apart from the rest, so a 2^12-ray group's box data stays in the L2 cache.
 
 use std::ops::Range;
 
@@ -12,9 +18,14 @@ use raylab_simd::{VMask, Vf32};
 
 use super::Mbvh;
 use super::single::RaySlab;
+use super::tri4::ShearX4;
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
 use crate::ray::{Hit, Ray};
 use crate::stats::TraversalStats;
+use crate::triangle::RayShear;
+
+/// Rays left over after whole packets of four, up to this many, are tested alone against the leaf.
+const ALONE_MAX: usize = 2;
 
 /// A pending task: `count` rays on top of lane `lane`'s stack reached child `child` (a node, or a leaf when
 /// `tris > 0`).
@@ -26,14 +37,31 @@ struct Task {
     count: u32,
 }
 
-/// Per-ray state of a stream.
-struct Slot<V: Vf32> {
-    slab: RaySlab<V>,
-    ray: Ray,
-    /// Current far limit: the closest hit so far (or `tmax`).
+/// What the box tests read of a ray, 32 bytes, kept apart from the rest so that a group of 2^12 rays' box
+/// data stays in the L2 cache.
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+struct Hot {
+    org: [f32; 3],
+    tmin: f32,
+    inv: [f32; 3],
+    /// Current far limit: the closest hit so far (or `tmax`); [`BLOCKED`] once a shadow ray is blocked.
     best: f32,
+}
+
+/// `Hot::best` of a blocked shadow ray: below every `tmin`, so its box tests all fail.
+const BLOCKED: f32 = f32::NEG_INFINITY;
+
+impl Hot {
+    fn blocked(&self) -> bool {
+        self.best == BLOCKED
+    }
+}
+
+/// The rest of a ray's state in a stream.
+struct Slot {
+    ray: Ray,
     hit: Option<Hit>,
-    blocked: bool,
 }
 
 impl Mbvh {
@@ -46,23 +74,25 @@ impl Mbvh {
         ordered: bool,
         stats: &mut TraversalStats,
     ) {
+        let emit = |i: usize, _: &Hot, s: &Slot| out[i] = s.hit;
         match self.backend {
             #[cfg(target_arch = "x86_64")]
             raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
-                self.stream::<raylab_simd::sse::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit)
+                self.stream::<raylab_simd::sse::F32x4>(rays, false, ordered, stats, emit)
             }
-            _ => self.stream::<raylab_simd::scalar::F32x4>(rays, false, ordered, stats, |i, s| out[i] = s.hit),
+            _ => self.stream::<raylab_simd::scalar::F32x4>(rays, false, ordered, stats, emit),
         }
     }
 
     /// Occlusion of a group of rays traced together; each ray leaves the stream at its first blocker.
     pub fn occluded_stream(&self, rays: &[Option<Ray>], out: &mut [bool], ordered: bool, stats: &mut TraversalStats) {
+        let emit = |i: usize, h: &Hot, _: &Slot| out[i] = h.blocked();
         match self.backend {
             #[cfg(target_arch = "x86_64")]
             raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
-                self.stream::<raylab_simd::sse::F32x4>(rays, true, ordered, stats, |i, s| out[i] = s.blocked)
+                self.stream::<raylab_simd::sse::F32x4>(rays, true, ordered, stats, emit)
             }
-            _ => self.stream::<raylab_simd::scalar::F32x4>(rays, true, ordered, stats, |i, s| out[i] = s.blocked),
+            _ => self.stream::<raylab_simd::scalar::F32x4>(rays, true, ordered, stats, emit),
         }
     }
 
@@ -72,15 +102,18 @@ impl Mbvh {
         shadow: bool,
         ordered: bool,
         stats: &mut TraversalStats,
-        mut emit: impl FnMut(usize, &Slot<V>),
+        mut emit: impl FnMut(usize, &Hot, &Slot),
     ) {
         assert_eq!(V::LANES, 4, "MBVH RS packs leaf rays four at a time");
-        let mut slots: Vec<Slot<V>> = Vec::with_capacity(rays.len());
+        let mut hot: Vec<Hot> = Vec::with_capacity(rays.len());
+        let mut slots: Vec<Slot> = Vec::with_capacity(rays.len());
         let mut ids: Vec<u32> = Vec::with_capacity(rays.len());
         for (i, r) in rays.iter().enumerate() {
             let ray = r.unwrap_or(Ray::new(glam::Vec3::ZERO, glam::Vec3::Z));
             let live = r.is_some_and(|r| r.is_valid());
-            slots.push(Slot { slab: RaySlab::new(&ray), ray, best: ray.tmax, hit: None, blocked: false });
+            let inv = ray.inv_dir().to_array();
+            hot.push(Hot { org: ray.origin.to_array(), tmin: ray.tmin, inv, best: ray.tmax });
+            slots.push(Slot { ray, hit: None });
             if live {
                 ids.push(i as u32);
             }
@@ -88,16 +121,17 @@ impl Mbvh {
         stats.rays += ids.len() as u64;
         stats.packets += ids.len().div_ceil(4) as u64;
         if !self.tri_ids.is_empty() && !ids.is_empty() {
-            self.walk_stream(&mut slots, ids, shadow, ordered, stats);
+            self.walk_stream::<V>(&mut hot, &mut slots, ids, shadow, ordered, stats);
         }
-        for (i, s) in slots.iter().enumerate() {
-            emit(i, s);
+        for (i, (h, s)) in hot.iter().zip(&slots).enumerate() {
+            emit(i, h, s);
         }
     }
 
     fn walk_stream<V: Vf32>(
         &self,
-        slots: &mut [Slot<V>],
+        hot: &mut [Hot],
+        slots: &mut [Slot],
         ids: Vec<u32>,
         shadow: bool,
         ordered: bool,
@@ -120,15 +154,24 @@ impl Mbvh {
             if task.tris > 0 {
                 leaves += 1;
                 // Shadow rays blocked since they were queued leave the stream here.
-                current.retain(|&i| !slots[i as usize].blocked);
+                current.retain(|&i| !hot[i as usize].blocked());
                 let c = current.len() as u64;
                 leaf_rays += c;
                 slots4 += c.div_ceil(4) * 4;
                 slots8 += c.div_ceil(8) * 8;
                 slots16 += c.div_ceil(16) * 16;
                 let tri_slots = task.child as usize..(task.child + task.tris) as usize;
-                for group in current.chunks(4) {
-                    tests += self.leaf_packet(slots, group, tri_slots.clone(), shadow);
+                // Whole packets go through the paper's four-rays-per-triangle tests; a remainder of one or
+                // two rays would leave most lanes idle, so each such ray takes the leaf's triangles four at a
+                // time instead, as a single ray does.
+                let alone = if current.len() % 4 <= ALONE_MAX { current.len() % 4 } else { 0 };
+                let (packed, single) = current.split_at(current.len() - alone);
+                for group in packed.chunks(4) {
+                    tests += self.leaf_packet::<V>(hot, slots, group, tri_slots.clone(), shadow);
+                }
+                for &id in single {
+                    let (h, s) = (&mut hot[id as usize], &mut slots[id as usize]);
+                    tests += self.leaf_single::<V>(h, s, tri_slots.clone(), shadow);
                 }
                 continue;
             }
@@ -142,12 +185,12 @@ impl Mbvh {
             }
             let mut lengths = V::splat(0.0);
             for &id in &current {
-                let s = &slots[id as usize];
-                if s.blocked {
+                let h = &hot[id as usize];
+                if h.blocked() {
                     continue;
                 }
                 box_tests += 1;
-                let (near, hit) = s.slab.test(node, s.ray.tmin, s.best);
+                let (near, hit) = RaySlab::<V>::from_parts(h.org, h.inv).test(node, h.tmin, h.best);
                 lengths = lengths + V::select(hit, near, V::splat(0.0));
                 let bits = hit.bits();
                 for (k, stack) in lanes.iter_mut().enumerate() {
@@ -188,13 +231,33 @@ impl Mbvh {
         stats.leaf_slots[2] += slots16;
     }
 
+    /// Tests one ray against the leaf's triangles, four at a time; returns the number of block tests.
+    fn leaf_single<V: Vf32>(&self, hot: &mut Hot, slot: &mut Slot, tri_slots: Range<usize>, shadow: bool) -> u64 {
+        let shear = ShearX4::<V>::new(&RayShear::new(&slot.ray));
+        let blocks = (tri_slots.len().div_ceil(4)) as u64;
+        if shadow {
+            if self.blocker_in_leaf(&shear, tri_slots, slot.ray.tmin, slot.ray.tmax).0.is_some() {
+                hot.best = BLOCKED;
+            }
+        } else {
+            self.closest_in_leaf(&shear, tri_slots, slot.ray.tmin, &mut hot.best, &mut slot.hit);
+        }
+        blocks
+    }
+
     /// Tests up to four rays, packed into a temporary SoA packet, against the leaf's triangles; returns the
     /// number of packet/triangle tests.
-    fn leaf_packet<V: Vf32>(&self, slots: &mut [Slot<V>], group: &[u32], tri_slots: Range<usize>, shadow: bool) -> u64 {
+    fn leaf_packet<V: Vf32>(
+        &self,
+        hot: &mut [Hot],
+        slots: &mut [Slot],
+        group: &[u32],
+        tri_slots: Range<usize>,
+        shadow: bool,
+    ) -> u64 {
         let mut rays = [None; 4];
         for (r, &id) in rays.iter_mut().zip(group) {
-            let s = &slots[id as usize];
-            *r = Some(Ray { tmax: s.best, ..s.ray });
+            *r = Some(Ray { tmax: hot[id as usize].best, ..slots[id as usize].ray });
         }
         let p = RayPacket::<V>::new(&rays[..group.len()]);
         let mut tests = 0;
@@ -210,7 +273,7 @@ impl Mbvh {
             let blocked = p.valid.bits() & !open.bits();
             for (k, &id) in group.iter().enumerate() {
                 if blocked >> k & 1 == 1 {
-                    slots[id as usize].blocked = true;
+                    hot[id as usize].best = BLOCKED;
                 }
             }
         } else {
@@ -222,9 +285,8 @@ impl Mbvh {
             let found = hits.to_hits();
             for (k, &id) in group.iter().enumerate() {
                 if let Some(h) = found[k] {
-                    let s = &mut slots[id as usize];
-                    s.best = h.t;
-                    s.hit = Some(h);
+                    hot[id as usize].best = h.t;
+                    slots[id as usize].hit = Some(h);
                 }
             }
         }
