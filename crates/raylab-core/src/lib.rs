@@ -22,6 +22,7 @@ pub mod scene;
 pub mod shadow;
 pub mod stats;
 pub mod trace;
+pub mod tri4;
 pub mod triangle;
 pub mod workload;
 

@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::node::{EMPTY, MbvhNode};
 use crate::aabb::Aabb;
+use crate::tri4;
 
 /// Triangles per leaf above which a node is always split.
 pub const MAX_LEAF: usize = 8;
@@ -37,7 +38,7 @@ impl Bin {
 pub struct Built {
     pub nodes: Vec<MbvhNode>,
     /// Each leaf's ids start at a multiple of four; the slots after a leaf up to the next multiple hold
-    /// [`EMPTY`], so a leaf is a whole number of four-triangle blocks.
+    /// [`tri4::PAD`], so a leaf is a whole number of four-triangle blocks.
     pub tri_ids: Vec<u32>,
     /// Nodes of the binary BVH before collapsing (for statistics).
     pub binary_nodes: usize,
@@ -65,20 +66,11 @@ pub fn build(boxes: &[Aabb], centroids: &[Vec3]) -> Built {
     Built { nodes, tri_ids, binary_nodes: count }
 }
 
-/// Moves every leaf's ids (keeping the leaves' order) to a slot that is a multiple of four, padding with
-/// [`EMPTY`], and points the leaves at their new slots.
+/// Aligns every leaf's ids on a four-triangle block ([`tri4::align_leaves`]).
 fn align_leaves(nodes: &mut [MbvhNode], ids: &[u32]) -> Vec<u32> {
-    let mut leaves: Vec<(usize, usize)> =
-        (0..nodes.len()).flat_map(|i| (0..4).map(move |k| (i, k))).filter(|&(i, k)| nodes[i].is_leaf(k)).collect();
-    leaves.sort_unstable_by_key(|&(i, k)| nodes[i].child[k]);
-    let mut out = Vec::with_capacity(ids.len() + 3 * leaves.len());
-    for (i, k) in leaves {
-        let (first, count) = (nodes[i].child[k] as usize, nodes[i].count[k] as usize);
-        nodes[i].child[k] = out.len() as u32;
-        out.extend_from_slice(&ids[first..first + count]);
-        out.resize(out.len().next_multiple_of(4), EMPTY);
-    }
-    out
+    let mut leaves: Vec<(&mut u32, u32)> =
+        nodes.iter_mut().flat_map(|n| n.child.iter_mut().zip(n.count)).filter(|(_, count)| *count > 0).collect();
+    tri4::align_leaves(ids, &mut leaves)
 }
 
 /// Relative padding of stored boxes: the slab test's rounding (a few ulps of the coordinates, amplified for

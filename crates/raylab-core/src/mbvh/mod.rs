@@ -6,11 +6,9 @@ mod node;
 mod refit;
 mod single;
 mod stream;
-mod tri4;
 
 pub use node::{EMPTY, MbvhNode};
 pub use refit::RefitError;
-use tri4::Tri4;
 
 use std::time::{Duration, Instant};
 
@@ -20,6 +18,7 @@ use serde::Serialize;
 
 use crate::aabb::Aabb;
 use crate::scene::Scene;
+use crate::tri4::{PAD, Tri4, blocks_of};
 use crate::triangle::TriangleSoup;
 
 /// A 4-wide BVH over a scene's triangles.
@@ -93,7 +92,7 @@ impl Mbvh {
     }
 
     /// Triangle ids indexed by leaves; each leaf starts at a multiple of four, and the padding slots after a
-    /// leaf hold [`EMPTY`].
+    /// leaf hold [`PAD`].
     pub fn tri_ids(&self) -> &[u32] {
         &self.tri_ids
     }
@@ -145,15 +144,10 @@ impl Mbvh {
 /// The slot of each of the `n` triangles in the padded leaf order `ids`.
 fn inverse(ids: &[u32], n: usize) -> Vec<u32> {
     let mut slot_of = vec![0u32; n];
-    for (slot, &id) in ids.iter().enumerate().filter(|(_, id)| **id != EMPTY) {
+    for (slot, &id) in ids.iter().enumerate().filter(|(_, id)| **id != PAD) {
         slot_of[id as usize] = slot as u32;
     }
     slot_of
-}
-
-/// Four-triangle blocks of a padded leaf-order soup (its length is a multiple of four).
-fn blocks_of(tris: &TriangleSoup) -> Vec<Tri4> {
-    tris.as_slice().chunks(4).map(Tri4::pack).collect()
 }
 
 /// Levels of 4-wide nodes below and including the root.

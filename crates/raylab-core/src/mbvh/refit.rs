@@ -37,7 +37,7 @@ impl Mbvh {
         }
         let start = Instant::now();
         self.tris = TriangleSoup::gather(scene, &self.tri_ids);
-        self.blocks = super::blocks_of(&self.tris);
+        self.blocks = crate::tri4::blocks_of(&self.tris);
         let mut node_box = vec![Aabb::EMPTY; self.nodes.len()];
         for i in (0..self.nodes.len()).rev() {
             let mut total = Aabb::EMPTY;

@@ -1,6 +1,6 @@
 //! Single-ray MBVH traversal (MBVH RS paper, section 3.1): one ray against the four boxes of a node at once,
 //! hit children visited nearest first, leaves' triangles tested four at a time with the watertight test
-//! ([`super::tri4`]). A node with one hit child hands it straight on and two are ordered with one comparison;
+//! ([`crate::tri4`]). A node with one hit child hands it straight on and two are ordered with one comparison;
 //! only three or four go through a small sort on the stack.
 //!
 //! The slab test takes each axis's entry and exit in the order the direction's sign gives and merges them with
@@ -14,9 +14,9 @@ use raylab_simd::{VMask, Vf32};
 
 use super::Mbvh;
 use super::node::MbvhNode;
-use super::tri4::ShearX4;
 use crate::ray::{Hit, Ray};
 use crate::stats::TraversalStats;
+use crate::tri4::{self, ShearX4};
 use crate::triangle::RayShear;
 
 /// Relative widening of a box's far distance (pbrt's `1 + 2 gamma(3)`).
@@ -107,8 +107,7 @@ impl Mbvh {
         best
     }
 
-    /// Tests the triangles in `slots` (a leaf, four to a block) and keeps a closer hit in `best`, lowering
-    /// `best_t` to it. Later lanes win ties, as when the triangles are tested one by one.
+    /// [`tri4::closest_in_leaf`] on this tree's blocks.
     #[inline(always)]
     pub(super) fn closest_in_leaf<V: Vf32>(
         &self,
@@ -118,23 +117,10 @@ impl Mbvh {
         best_t: &mut f32,
         best: &mut Option<Hit>,
     ) {
-        for b in slots.start / 4..slots.end.div_ceil(4) {
-            let h = shear.test(&self.blocks[b], tmin, *best_t);
-            let mut bits = h.mask.bits();
-            while bits != 0 {
-                let lane = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let t = h.t.lane(lane);
-                if t <= *best_t {
-                    *best_t = t;
-                    *best = Some(Hit { t, tri: self.tri_ids[4 * b + lane], u: h.u.lane(lane), v: h.v.lane(lane) });
-                }
-            }
-        }
+        tri4::closest_in_leaf(shear, &self.blocks, &self.tri_ids, slots, tmin, best_t, best);
     }
 
-    /// The first triangle in `slots` (a leaf, four to a block) found to block `(tmin, tmax]`, and the number
-    /// of triangles tested until then.
+    /// [`tri4::blocker_in_leaf`] on this tree's blocks.
     #[inline(always)]
     pub(super) fn blocker_in_leaf<V: Vf32>(
         &self,
@@ -143,15 +129,7 @@ impl Mbvh {
         tmin: f32,
         tmax: f32,
     ) -> (Option<u32>, u64) {
-        let mut tests = 0;
-        for b in slots.start / 4..slots.end.div_ceil(4) {
-            tests += (slots.end - 4 * b).min(4) as u64;
-            let bits = shear.test(&self.blocks[b], tmin, tmax).mask.bits();
-            if bits != 0 {
-                return (Some(self.tri_ids[4 * b + bits.trailing_zeros() as usize]), tests);
-            }
-        }
-        (None, tests)
+        tri4::blocker_in_leaf(shear, &self.blocks, &self.tri_ids, slots, tmin, tmax)
     }
 
     /// True when triangle `tri` blocks `ray` (the shadow cache's test).

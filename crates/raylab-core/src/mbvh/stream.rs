@@ -18,10 +18,10 @@ use raylab_simd::{VMask, Vf32};
 
 use super::Mbvh;
 use super::single::RaySlab;
-use super::tri4::ShearX4;
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
 use crate::ray::{Hit, Ray};
 use crate::stats::TraversalStats;
+use crate::tri4::ShearX4;
 use crate::triangle::RayShear;
 
 /// Rays left over after whole packets of four, up to this many, are tested alone against the leaf.
