@@ -18,6 +18,7 @@ use std::ops::Range;
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
+use crate::packet::sheared_test;
 use crate::ray::Hit;
 use crate::triangle::{RayShear, TriHit, TriangleSoup};
 
@@ -166,35 +167,10 @@ impl<V: Vf32> ShearX4<V> {
     /// Tests the four triangles of `b`, reporting hits with `tmin < t <= tmax` as [`RayShear::intersect`].
     #[inline(always)]
     pub fn test(&self, b: &Tri4, tmin: f32, tmax: f32) -> BlockHits<V> {
-        let [sx, sy, sz] = self.s;
-        let (a_x, a_y, a_z) = self.corner(b, 0);
-        let (b_x, b_y, b_z) = self.corner(b, 1);
-        let (c_x, c_y, c_z) = self.corner(b, 2);
-        let ax = a_x - sx * a_z;
-        let ay = a_y - sy * a_z;
-        let bx = b_x - sx * b_z;
-        let by = b_y - sy * b_z;
-        let cx = c_x - sx * c_z;
-        let cy = c_y - sy * c_z;
-        let u = cx * by - cy * bx;
-        let v = ax * cy - ay * cx;
-        let w = bx * ay - by * ax;
-        let zero = V::splat(0.0);
-        let exact_zero = u.eq(zero) | v.eq(zero) | w.eq(zero);
-        let neg = u.lt(zero) | v.lt(zero) | w.lt(zero);
-        let pos = u.gt(zero) | v.gt(zero) | w.gt(zero);
-        let det = u + v + w;
-        let t_scaled = u * (sz * a_z) + v * (sz * b_z) + w * (sz * c_z);
-        let abs_det = det.abs();
-        let t_signed = V::select(det.lt(zero), zero - t_scaled, t_scaled);
-        let (vmin, vmax) = (V::splat(tmin), V::splat(tmax));
-        let inside = t_signed.gt(vmin * abs_det) & t_signed.le(vmax * abs_det);
-        let inv = V::splat(1.0) / det;
-        let t = t_scaled * inv;
-        let in_range = t.gt(vmin) & t.le(vmax);
-        let mask = !exact_zero & !(neg & pos) & !det.eq(zero) & inside & in_range;
-        let hits = BlockHits { mask, t, u: v * inv, v: w * inv };
-        if exact_zero.none() { hits } else { self.redo(b, hits, exact_zero.bits(), tmin, tmax) }
+        let corners = [self.corner(b, 0), self.corner(b, 1), self.corner(b, 2)];
+        let lanes = sheared_test(corners, self.s, V::splat(tmin), V::splat(tmax));
+        let hits = BlockHits { mask: lanes.hit, t: lanes.t, u: lanes.u, v: lanes.v };
+        if lanes.exact_zero.none() { hits } else { self.redo(b, hits, lanes.exact_zero.bits(), tmin, tmax) }
     }
 
     /// Rare: lanes with an exactly zero edge function, which the scalar test decides in double precision.

@@ -234,7 +234,7 @@ impl Mbvh {
     /// Tests one ray against the leaf's triangles, four at a time; returns the number of block tests.
     fn leaf_single<V: Vf32>(&self, hot: &mut Hot, slot: &mut Slot, tri_slots: Range<usize>, shadow: bool) -> u64 {
         let shear = ShearX4::<V>::new(&RayShear::new(&slot.ray));
-        let blocks = (tri_slots.len().div_ceil(4)) as u64;
+        let blocks = tri_slots.len().div_ceil(4) as u64;
         if shadow {
             if self.blocker_in_leaf(&shear, tri_slots, slot.ray.tmin, slot.ray.tmax).0.is_some() {
                 hot.best = BLOCKED;

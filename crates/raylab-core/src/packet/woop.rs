@@ -30,6 +30,53 @@ fn rel_permuted<V: Vf32>(p: &RayPacket<V>, v: Vec3) -> (V, V, V) {
     (pick::<V>(kx, q[0], q[1], q[2]), pick::<V>(ky, q[0], q[1], q[2]), pick::<V>(kz, q[0], q[1], q[2]))
 }
 
+/// The watertight test's arithmetic in every lane: corners relative to the lanes' origins and permuted into
+/// their `(kx, ky, kz)` order, sheared by `(S_x, S_y, S_z)`; lanes hit within `(tmin, tmax]`. Shared by the
+/// packet test (four rays, one triangle) and [`crate::tri4`] (one ray, four triangles), each lane performing
+/// [`crate::triangle::RayShear::intersect`]'s `f32` operations in its order.
+#[inline(always)]
+pub(crate) fn sheared_test<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3], tmin: V, tmax: V) -> Sheared<V> {
+    let [(a_x, a_y, a_z), (b_x, b_y, b_z), (c_x, c_y, c_z)] = corners;
+    let ax = a_x - sx * a_z;
+    let ay = a_y - sy * a_z;
+    let bx = b_x - sx * b_z;
+    let by = b_y - sy * b_z;
+    let cx = c_x - sx * c_z;
+    let cy = c_y - sy * c_z;
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    let zero = V::splat(0.0);
+    let exact_zero = u.eq(zero) | v.eq(zero) | w.eq(zero);
+    let neg = u.lt(zero) | v.lt(zero) | w.lt(zero);
+    let pos = u.gt(zero) | v.gt(zero) | w.gt(zero);
+    let det = u + v + w;
+    let t_scaled = u * (sz * a_z) + v * (sz * b_z) + w * (sz * c_z);
+    let abs_det = det.abs();
+    let t_signed = V::select(det.lt(zero), zero - t_scaled, t_scaled);
+    let inside = t_signed.gt(tmin * abs_det) & t_signed.le(tmax * abs_det);
+    let inv = V::splat(1.0) / det;
+    let t = t_scaled * inv;
+    let in_range = t.gt(tmin) & t.le(tmax);
+    let hit = !exact_zero & !(neg & pos) & !det.eq(zero) & inside & in_range;
+    Sheared { hit, exact_zero, t, u: v * inv, v: w * inv }
+}
+
+/// What [`sheared_test`] finds per lane.
+pub(crate) struct Sheared<V: Vf32> {
+    /// Lanes hit (never those in `exact_zero`).
+    pub hit: V::Mask,
+    /// Lanes with an edge function of exactly zero, which the scalar test's double-precision fallback must
+    /// decide.
+    pub exact_zero: V::Mask,
+    /// Distances.
+    pub t: V,
+    /// Weights of corner 1.
+    pub u: V,
+    /// Weights of corner 2.
+    pub v: V,
+}
+
 /// Result of testing one triangle: lanes hit and their distances and barycentrics.
 struct LaneHits<V: Vf32> {
     mask: V::Mask,
@@ -42,38 +89,14 @@ struct LaneHits<V: Vf32> {
 fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
     // Corners relative to the origins, permuted into (kx, ky, kz) order: by indexing when every lane shares
     // the permutation, by per-lane selects otherwise. Both give each lane exactly `v[k] - o[k]`.
-    let [sx, sy, sz] = p.shear;
-    let ((a_x, a_y, a_z), (b_x, b_y, b_z), (c_x, c_y, c_z)) = match p.uniform_axes {
-        Some(k) => (rel_uniform(p, tri[0], k), rel_uniform(p, tri[1], k), rel_uniform(p, tri[2], k)),
-        None => (rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])),
+    let corners = match p.uniform_axes {
+        Some(k) => [rel_uniform(p, tri[0], k), rel_uniform(p, tri[1], k), rel_uniform(p, tri[2], k)],
+        None => [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])],
     };
-    let ax = a_x - sx * a_z;
-    let ay = a_y - sy * a_z;
-    let bx = b_x - sx * b_z;
-    let by = b_y - sy * b_z;
-    let cx = c_x - sx * c_z;
-    let cy = c_y - sy * c_z;
-    let u = cx * by - cy * bx;
-    let v = ax * cy - ay * cx;
-    let w = bx * ay - by * ax;
-    let zero = V::splat(0.0);
-    let exact_zero = (u.eq(zero) | v.eq(zero) | w.eq(zero)) & active;
-    let neg = u.lt(zero) | v.lt(zero) | w.lt(zero);
-    let pos = u.gt(zero) | v.gt(zero) | w.gt(zero);
-    let det = u + v + w;
-    let az = sz * a_z;
-    let bz = sz * b_z;
-    let cz = sz * c_z;
-    let t_scaled = u * az + v * bz + w * cz;
-    let det_neg = det.lt(zero);
-    let abs_det = det.abs();
-    let t_signed = V::select(det_neg, zero - t_scaled, t_scaled);
-    let inside = t_signed.gt(p.tmin * abs_det) & t_signed.le(tmax * abs_det);
-    let inv = V::splat(1.0) / det;
-    let t = t_scaled * inv;
-    let in_range = t.gt(p.tmin) & t.le(tmax);
-    let mut mask = active & !exact_zero & !(neg & pos) & !det.eq(zero) & inside & in_range;
-    let (mut t, mut bu, mut bv) = (t, v * inv, w * inv);
+    let lanes = sheared_test(corners, p.shear, p.tmin, tmax);
+    let exact_zero = lanes.exact_zero & active;
+    let mut mask = lanes.hit & active;
+    let (mut t, mut bu, mut bv) = (lanes.t, lanes.u, lanes.v);
     if exact_zero.any() {
         // Rare: an edge function is exactly zero, and the paper recomputes it in double precision. Let the
         // scalar test, which does exactly that, decide those lanes.
