@@ -140,4 +140,20 @@ impl Vf32 for F32x4 {
     fn abs(self) -> Self {
         Self(sse!(_mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff)))))
     }
+    #[inline(always)]
+    fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
+        // SAFETY: each row is a reference to four readable `f32`s and `loadu` has no alignment requirement.
+        let load = |i: usize| unsafe { _mm_loadu_ps(rows[i].as_ptr()) };
+        let (a, b, c, d) = (load(0), load(1), load(2), load(3));
+        sse!({
+            let (ab_lo, cd_lo) = (_mm_unpacklo_ps(a, b), _mm_unpacklo_ps(c, d));
+            let (ab_hi, cd_hi) = (_mm_unpackhi_ps(a, b), _mm_unpackhi_ps(c, d));
+            [
+                Self(_mm_movelh_ps(ab_lo, cd_lo)),
+                Self(_mm_movehl_ps(cd_lo, ab_lo)),
+                Self(_mm_movelh_ps(ab_hi, cd_hi)),
+                Self(_mm_movehl_ps(cd_hi, ab_hi)),
+            ]
+        })
+    }
 }

@@ -1,157 +1,109 @@
-//! Eight `f32` lanes, the width of AVX registers (thesis 4.1.2 expects packets to widen with the SIMD
-//! units; these give the 4x2 packets).
+//! Eight `f32` lanes in one AVX register (thesis 4.1.2 expects packets to widen with the SIMD units; these
+//! give the 4x2 packets), with exactly the SSE backend's semantics (`min`/`max` return the second operand when
+//! either is NaN).
 //!
-//! The lanes live in a 32-byte-aligned array and every operation is written per lane, with exactly the SSE
-//! backend's semantics (`min`/`max` return the second operand when either is NaN). That code is safe on any
-//! CPU: compiled on its own it becomes pairs of SSE instructions, and inside [`crate::dispatch`]'s AVX2 entry
-//! point (where kernels are inlined) the compiler turns each operation into one 256-bit instruction, so the
-//! kernels get AVX2 without any AVX intrinsic that could run on a CPU lacking it.
+//! The types are private to this crate and only [`crate::dispatch`]'s AVX2 entry point instantiates kernels
+//! with them, after checking that the CPU has AVX2 and FMA: no value of them, and so none of the AVX
+//! instructions below, can exist on a CPU without those features. Kernels are inlined into that entry point,
+//! which is compiled for AVX2, so every operation becomes one 256-bit instruction.
 
+use std::arch::x86_64::*;
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Not, Sub};
 
 use crate::{VMask, Vf32};
 
+/// Evaluates an expression of register-only AVX/AVX2 intrinsics.
+macro_rules! avx {
+    ($e:expr) => {
+        // SAFETY: values of this module's types are only created by kernels that `run_avx2` runs, and it is
+        // only called once `is_x86_feature_detected!` has confirmed AVX2 and FMA (see the module docs); these
+        // intrinsics only read and write registers.
+        unsafe { $e }
+    };
+}
+
 /// Eight `f32` lanes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(32))]
-pub struct F32x8(pub [f32; 8]);
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct F32x8(__m256);
 
-/// Eight lane masks, all bits set or clear per lane (the layout of SSE/AVX comparison results).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(C, align(32))]
-pub struct M32x8([i32; 8]);
-
-impl F32x8 {
-    // Plain loops rather than `array::from_fn`/`map`, whose helpers are not always inlined: each operation
-    // must stay a handful of instructions inside the kernel for the compiler to vectorise it.
-    #[inline(always)]
-    fn map(self, f: impl Fn(f32) -> f32) -> Self {
-        let mut r = [0.0; 8];
-        for (i, lane) in r.iter_mut().enumerate() {
-            *lane = f(self.0[i]);
-        }
-        Self(r)
-    }
-
-    #[inline(always)]
-    fn map2(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
-        let mut r = [0.0; 8];
-        for (i, lane) in r.iter_mut().enumerate() {
-            *lane = f(self.0[i], o.0[i]);
-        }
-        Self(r)
-    }
-
-    /// Folds the lanes pairwise (halves, then quarters, then the last two), so the steps vectorise; `pick`
-    /// must ignore a NaN operand unless both are NaN, as the trait's reductions do.
-    #[inline(always)]
-    fn reduce(self, pick: impl Fn(f32, f32) -> f32) -> f32 {
-        let v = self.0;
-        let h = [pick(v[0], v[4]), pick(v[1], v[5]), pick(v[2], v[6]), pick(v[3], v[7])];
-        let q = [pick(h[0], h[2]), pick(h[1], h[3])];
-        pick(q[0], q[1])
-    }
-
-    #[inline(always)]
-    fn test(self, o: Self, f: impl Fn(f32, f32) -> bool) -> M32x8 {
-        let mut r = [0; 8];
-        for (i, lane) in r.iter_mut().enumerate() {
-            *lane = -(f(self.0[i], o.0[i]) as i32);
-        }
-        M32x8(r)
-    }
-}
-
-impl M32x8 {
-    #[inline(always)]
-    fn map2(self, o: Self, f: impl Fn(i32, i32) -> i32) -> Self {
-        let mut r = [0; 8];
-        for (i, lane) in r.iter_mut().enumerate() {
-            *lane = f(self.0[i], o.0[i]);
-        }
-        Self(r)
-    }
-}
+/// Eight lane masks (all bits set or clear per lane), as AVX comparisons produce them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct M32x8(__m256);
 
 impl VMask for M32x8 {
     #[inline(always)]
     fn bits(self) -> u32 {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_mm_load_ps, _mm_movemask_ps};
-            // SAFETY: SSE2 is part of the x86-64 baseline, so these intrinsics run on every x86-64 CPU; the
-            // array is 32-byte aligned, so both 16-byte halves satisfy `_mm_load_ps`'s alignment, and each
-            // half holds four readable lanes. Written this way, the AVX2 entry point compiles it to a single
-            // `vmovmskps` on the 256-bit register.
-            unsafe {
-                let lo = _mm_load_ps(self.0.as_ptr().cast::<f32>());
-                let hi = _mm_load_ps(self.0.as_ptr().add(4).cast::<f32>());
-                (_mm_movemask_ps(lo) | (_mm_movemask_ps(hi) << 4)) as u32
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            (0..8).fold(0, |b, i| b | ((self.0[i] as u32) >> 31) << i)
-        }
+        avx!(_mm256_movemask_ps(self.0)) as u32
     }
     #[inline(always)]
     fn from_bits(bits: u32) -> Self {
-        let mut r = [0; 8];
-        for (i, lane) in r.iter_mut().enumerate() {
-            *lane = -((bits >> i & 1) as i32);
-        }
-        Self(r)
+        avx!({
+            let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let set = _mm256_and_si256(_mm256_set1_epi32(bits as i32), lane_bits);
+            Self(_mm256_castsi256_ps(_mm256_cmpeq_epi32(set, lane_bits)))
+        })
     }
 }
 
-impl BitAnd for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitand(self, o: Self) -> Self {
-        self.map2(o, |a, b| a & b)
-    }
-}
-
-impl BitOr for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitor(self, o: Self) -> Self {
-        self.map2(o, |a, b| a | b)
-    }
-}
-
-impl BitXor for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitxor(self, o: Self) -> Self {
-        self.map2(o, |a, b| a ^ b)
-    }
-}
-
-impl Not for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn not(self) -> Self {
-        self.map2(Self([-1; 8]), |a, b| a ^ b)
-    }
-}
-
-macro_rules! arith {
-    ($trait:ident, $f:ident, $op:tt) => {
-        impl $trait for F32x8 {
+macro_rules! mask_op {
+    ($trait:ident, $f:ident, $intr:ident) => {
+        impl $trait for M32x8 {
             type Output = Self;
             #[inline(always)]
             fn $f(self, o: Self) -> Self {
-                self.map2(o, |a, b| a $op b)
+                Self(avx!($intr(self.0, o.0)))
             }
         }
     };
 }
 
-arith!(Add, add, +);
-arith!(Sub, sub, -);
-arith!(Mul, mul, *);
-arith!(Div, div, /);
+mask_op!(BitAnd, bitand, _mm256_and_ps);
+mask_op!(BitOr, bitor, _mm256_or_ps);
+mask_op!(BitXor, bitxor, _mm256_xor_ps);
+
+impl Not for M32x8 {
+    type Output = Self;
+    #[inline(always)]
+    fn not(self) -> Self {
+        Self(avx!(_mm256_xor_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))))
+    }
+}
+
+macro_rules! arith {
+    ($trait:ident, $f:ident, $intr:ident) => {
+        impl $trait for F32x8 {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(self, o: Self) -> Self {
+                Self(avx!($intr(self.0, o.0)))
+            }
+        }
+    };
+}
+
+arith!(Add, add, _mm256_add_ps);
+arith!(Sub, sub, _mm256_sub_ps);
+arith!(Mul, mul, _mm256_mul_ps);
+arith!(Div, div, _mm256_div_ps);
+
+impl F32x8 {
+    /// The lanes as an array.
+    #[inline(always)]
+    fn to_array(self) -> [f32; 8] {
+        let mut a = [0.0; 8];
+        self.write_to(&mut a);
+        a
+    }
+
+    /// Folds the lanes pairwise (halves, then quarters, then the last two); `pick` must ignore a NaN operand
+    /// unless both are NaN, as the trait's reductions do.
+    #[inline(always)]
+    fn reduce(self, pick: impl Fn(f32, f32) -> f32) -> f32 {
+        let v = self.to_array();
+        let h = [pick(v[0], v[4]), pick(v[1], v[5]), pick(v[2], v[6]), pick(v[3], v[7])];
+        pick(pick(h[0], h[2]), pick(h[1], h[3]))
+    }
+}
 
 impl Vf32 for F32x8 {
     type Mask = M32x8;
@@ -159,51 +111,49 @@ impl Vf32 for F32x8 {
 
     #[inline(always)]
     fn splat(x: f32) -> Self {
-        Self([x; 8])
+        Self(avx!(_mm256_set1_ps(x)))
     }
     #[inline(always)]
     fn from_slice(s: &[f32]) -> Self {
-        let mut r = [0.0; 8];
-        r.copy_from_slice(&s[..8]);
-        Self(r)
+        assert!(s.len() >= 8);
+        // SAFETY: the assert guarantees eight readable `f32`s and `loadu` has no alignment requirement; AVX is
+        // present (see `avx!`).
+        Self(unsafe { _mm256_loadu_ps(s.as_ptr()) })
     }
     #[inline(always)]
     fn write_to(self, out: &mut [f32]) {
-        out[..8].copy_from_slice(&self.0);
+        assert!(out.len() >= 8);
+        // SAFETY: the assert guarantees eight writable `f32`s and `storeu` has no alignment requirement; AVX is
+        // present (see `avx!`).
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) }
     }
     #[inline(always)]
     fn lane(self, i: usize) -> f32 {
-        self.0[i]
+        self.to_array()[i]
     }
     #[inline(always)]
     fn lt(self, o: Self) -> M32x8 {
-        self.test(o, |a, b| a < b)
+        M32x8(avx!(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0)))
     }
     #[inline(always)]
     fn le(self, o: Self) -> M32x8 {
-        self.test(o, |a, b| a <= b)
+        M32x8(avx!(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)))
     }
     #[inline(always)]
     fn eq(self, o: Self) -> M32x8 {
-        self.test(o, |a, b| a == b)
+        M32x8(avx!(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)))
     }
     #[inline(always)]
     fn min(self, o: Self) -> Self {
-        // `minps`: the second operand unless the first is smaller (so NaN in either gives the second).
-        self.map2(o, |a, b| if a < b { a } else { b })
+        Self(avx!(_mm256_min_ps(self.0, o.0)))
     }
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        self.map2(o, |a, b| if a > b { a } else { b })
+        Self(avx!(_mm256_max_ps(self.0, o.0)))
     }
     #[inline(always)]
     fn select(m: M32x8, a: Self, b: Self) -> Self {
-        let mut r = [0.0; 8];
-        for (i, lane) in r.iter_mut().enumerate() {
-            let keep = m.0[i] as u32;
-            *lane = f32::from_bits((a.0[i].to_bits() & keep) | (b.0[i].to_bits() & !keep));
-        }
-        Self(r)
+        Self(avx!(_mm256_blendv_ps(b.0, a.0, m.0)))
     }
     #[inline(always)]
     fn reduce_min(self) -> f32 {
@@ -215,6 +165,27 @@ impl Vf32 for F32x8 {
     }
     #[inline(always)]
     fn abs(self) -> Self {
-        self.map(|a| f32::from_bits(a.to_bits() & 0x7fff_ffff))
+        Self(avx!(_mm256_and_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff)))))
+    }
+    #[inline(always)]
+    fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
+        assert!(rows.len() >= 8);
+        // Rows i and i + 4 share a register (low and high half); the 4x4 transpose then runs in both halves.
+        let pair = |i: usize| {
+            // SAFETY: each row is a reference to four readable `f32`s and `loadu` has no alignment
+            // requirement; AVX is present (see `avx!`).
+            unsafe { _mm256_loadu2_m128(rows[i + 4].as_ptr(), rows[i].as_ptr()) }
+        };
+        let (a, b, c, d) = (pair(0), pair(1), pair(2), pair(3));
+        avx!({
+            let (ab_lo, cd_lo) = (_mm256_unpacklo_ps(a, b), _mm256_unpacklo_ps(c, d));
+            let (ab_hi, cd_hi) = (_mm256_unpackhi_ps(a, b), _mm256_unpackhi_ps(c, d));
+            [
+                Self(_mm256_shuffle_ps::<0x44>(ab_lo, cd_lo)),
+                Self(_mm256_shuffle_ps::<0xee>(ab_lo, cd_lo)),
+                Self(_mm256_shuffle_ps::<0x44>(ab_hi, cd_hi)),
+                Self(_mm256_shuffle_ps::<0xee>(ab_hi, cd_hi)),
+            ]
+        })
     }
 }

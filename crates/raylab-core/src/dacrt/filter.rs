@@ -13,9 +13,8 @@ use glam::Vec3;
 use raylab_simd::{Backend, Kernel, VMask, Vf32};
 
 use super::partition::partition;
-use super::records::RayRecord;
+use super::records::{RayRecord, row_lanes};
 use crate::aabb::Aabb;
-use crate::packet::MAX_LANES;
 
 /// Relative widening of a box's far distance (pbrt's `1 + 2 gamma(3)`).
 const FAR_SLACK: f32 = 2.0 * 3.0 * f32::EPSILON;
@@ -90,15 +89,11 @@ fn classify_lanes<V: Vf32, const N: usize>(rays: &[RayRecord], boxes: &[FilterBo
     let zero = V::splat(0.0);
     let slack = V::splat(FAR_SLACK);
     for (block, out) in rays.chunks(lanes).zip(flags.chunks_exact_mut(lanes)) {
-        // A short last block repeats its first ray in the missing lanes.
-        let mut rs = [&block[0]; MAX_LANES];
-        for (k, r) in rs.iter_mut().enumerate().take(lanes) {
-            *r = &block[k.min(block.len() - 1)];
-        }
-        let org = [gather::<V>(&rs, |r| r.org.x), gather(&rs, |r| r.org.y), gather(&rs, |r| r.org.z)];
-        let inv = [gather::<V>(&rs, |r| r.inv.x), gather(&rs, |r| r.inv.y), gather(&rs, |r| r.inv.z)];
+        let [ox, oy, oz, tmin] = row_lanes::<V>(block, 0);
+        let [_, _, _, tmax] = row_lanes::<V>(block, 1);
+        let [ix, iy, iz, _] = row_lanes::<V>(block, 2);
+        let (org, inv) = ([ox, oy, oz], [ix, iy, iz]);
         let neg = [inv[0].lt(zero), inv[1].lt(zero), inv[2].lt(zero)];
-        let (tmin, tmax) = (gather::<V>(&rs, |r| r.tmin), gather::<V>(&rs, |r| r.tmax));
         let mut bytes = 0u64;
         for (k, (bmin, bmax)) in corners.iter().enumerate() {
             let (mut near, mut far) = (tmin, tmax);
@@ -116,16 +111,6 @@ fn classify_lanes<V: Vf32, const N: usize>(rays: &[RayRecord], boxes: &[FilterBo
         }
         out.copy_from_slice(&bytes.to_le_bytes()[..lanes]);
     }
-}
-
-/// One field of the rays `rs` in SIMD lanes.
-#[inline(always)]
-fn gather<V: Vf32>(rs: &[&RayRecord; MAX_LANES], f: impl Fn(&RayRecord) -> f32) -> V {
-    let mut v = [0.0; MAX_LANES];
-    for (lane, r) in v.iter_mut().zip(rs).take(V::LANES) {
-        *lane = f(r);
-    }
-    V::from_slice(&v[..V::LANES])
 }
 
 /// Moves the rays of `rays` that enter `b` to the front and returns how many there are; `flags` is scratch.

@@ -5,11 +5,15 @@
 
 use glam::{Vec3, Vec4};
 
+use raylab_simd::Vf32;
+
 use crate::aabb::Aabb;
+use crate::packet::MAX_LANES;
 use crate::ray::Ray;
 
-/// A ray as DACRT stores it: 48 bytes, moved (not indexed) by every filter pass.
-#[derive(Clone, Copy, Debug)]
+/// A ray as DACRT stores it: 48 bytes, moved (not indexed) by every filter pass. Its three 16-byte rows
+/// ([`RayRecord::rows`]) are what the filter transposes into SIMD lanes.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub(super) struct RayRecord {
     /// Start point.
@@ -33,10 +37,22 @@ impl RayRecord {
         Self { org: ray.origin, tmin: ray.tmin, dir: ray.dir, tmax: ray.tmax, inv: ray.inv_dir(), id }
     }
 
-    /// The ray over its current interval.
-    pub fn ray(&self) -> Ray {
-        Ray::segment(self.org, self.dir, self.tmin, self.tmax)
+    /// The record as three rows of four floats: `[org, tmin]`, `[dir, tmax]` and `[inv, id bits]`.
+    #[inline(always)]
+    pub fn rows(&self) -> &[[f32; 4]; 3] {
+        bytemuck::cast_ref(self)
     }
+}
+
+/// Row `i` of the rays of `block` ([`RayRecord::rows`]) transposed into lanes, one vector per field; a short
+/// block repeats its first ray in the missing lanes.
+#[inline(always)]
+pub(super) fn row_lanes<V: Vf32>(block: &[RayRecord], i: usize) -> [V; 4] {
+    let mut rs = [&block[0].rows()[i]; MAX_LANES];
+    for (k, r) in rs.iter_mut().enumerate().take(V::LANES) {
+        *r = &block[k.min(block.len() - 1)].rows()[i];
+    }
+    V::transpose_rows(&rs)
 }
 
 /// A triangle as DACRT moves it: its box and its id in the scene (32 bytes). Division, which every set pays

@@ -7,7 +7,7 @@ use raylab_simd::{Backend, Kernel, VMask, Vf32};
 
 use super::filter::{FilterBox, classify};
 use super::partition::partition;
-use super::records::{RayRecord, SetBounds, TriRecord};
+use super::records::{RayRecord, SetBounds, TriRecord, row_lanes};
 use super::split::divide;
 use super::{DacrtParams, TopNode};
 use crate::packet::{MAX_LANES, PacketHits, RayPacket, intersect_packet, occlude_packet};
@@ -29,14 +29,12 @@ pub(super) trait Answer {
     fn leaf<V: Vf32>(&mut self, soup: &TriangleSoup, rays: &mut [RayRecord], tris: &[TriRecord]);
 }
 
-/// `V::LANES` rays (or fewer, at the end) in a temporary packet.
+/// `V::LANES` rays (or fewer, at the end) in a temporary packet, loaded by transposing their records.
 #[inline(always)]
 fn packet<V: Vf32>(group: &[RayRecord]) -> RayPacket<V> {
-    let mut lanes = [None; MAX_LANES];
-    for (l, r) in lanes.iter_mut().zip(group.iter()) {
-        *l = Some(r.ray());
-    }
-    RayPacket::<V>::new(&lanes[..group.len()])
+    let [ox, oy, oz, tmin] = row_lanes::<V>(group, 0);
+    let [dx, dy, dz, tmax] = row_lanes::<V>(group, 1);
+    RayPacket::from_lanes([ox, oy, oz], [dx, dy, dz], tmin, tmax, (1 << group.len()) - 1)
 }
 
 /// A leaf's work as a [`Kernel`], so that it runs with the backend's widest lanes (the recursion itself

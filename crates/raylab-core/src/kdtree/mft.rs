@@ -13,7 +13,7 @@ use super::frustum::{Leaf, front_and_back, hit_limit, leaf_intersect, leaf_occlu
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::Aabb;
-use crate::packet::{Bundle4, Frustum, MAX_LANES, PacketTile, bundle_lanes};
+use crate::packet::{Bundle4, Frustum, MAX_LANES, PacketTile, bundle_lanes, map3};
 use crate::stats::TraversalStats;
 
 /// Four frustums with a common origin, one per SIMD lane.
@@ -41,7 +41,7 @@ impl<V: Vf32> Frustum4<V> {
         assert!(f.iter().flatten().all(|x| x.origin == origin), "MFT frustums share their origin");
         let lanes = |g: &dyn Fn(&Frustum) -> f32, empty: f32| bundle_lanes::<V, _>(&f, g, empty);
         let axes =
-            |g: &dyn Fn(&Frustum, usize) -> f32, empty: f32| [0, 1, 2].map(|k| lanes(&|x: &Frustum| g(x, k), empty));
+            |g: &dyn Fn(&Frustum, usize) -> f32, empty: f32| map3([0, 1, 2], |k| lanes(&|x: &Frustum| g(x, k), empty));
         let valid = f.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
         Some(Self {
             origin,

@@ -15,7 +15,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{Disc, RayPacket, bundle_lanes, tile::Bundle, tile::Bundle4};
+use super::{Disc, RayPacket, bundle_lanes, map3, tile::Bundle, tile::Bundle4};
 
 /// A cone bounding a bundle of rays from one origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,16 +93,19 @@ impl Cone {
     /// The cone of the valid rays of `packets[set]`, which all start at `origin`.
     #[inline(always)]
     pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>], set: &[usize]) -> Option<Self> {
-        let segs = set.iter().flat_map(|&j| {
+        // The lanes are read out here, in a plain loop, so that no vector code runs inside `bounding`'s
+        // iterator, which the compiler may keep out of line (see `map3`).
+        let mut segs = Vec::with_capacity(set.len() * V::LANES);
+        for &j in set {
             let p = &packets[j];
             let bits = p.valid.bits();
-            (0..V::LANES).filter(move |i| bits >> i & 1 == 1).map(move |i| {
+            for i in (0..V::LANES).filter(|i| bits >> i & 1 == 1) {
                 let r = p.ray(i);
                 let len = r.dir.length();
-                (r.dir / len, r.tmin * len, r.tmax * len)
-            })
-        });
-        Self::bounding(origin, segs)
+                segs.push((r.dir / len, r.tmin * len, r.tmax * len));
+            }
+        }
+        Self::bounding(origin, segs.into_iter())
     }
 }
 
@@ -166,8 +169,8 @@ impl<V: Vf32> Cone4<V> {
         let valid = c.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
         Some(Self {
             origin,
-            inv_hi: [0, 1, 2].map(|k| lanes(&|x: &Cone| x.inv_hi[k], 0.0)),
-            inv_lo: [0, 1, 2].map(|k| lanes(&|x: &Cone| x.inv_lo[k], 0.0)),
+            inv_hi: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.inv_hi[k], 0.0)),
+            inv_lo: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.inv_lo[k], 0.0)),
             t_min: lanes(&|x| x.t_min, f32::INFINITY),
             t_max: lanes(&|x| x.t_max, f32::NEG_INFINITY),
             origin_slack: c.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack)),

@@ -68,10 +68,16 @@ impl<V: Vf32> RayPacket<V> {
                 field[i] = v;
             }
         }
-        let [ox, oy, oz] = [load(&f[0]), load(&f[1]), load(&f[2])];
-        let [dx, dy, dz] = [load(&f[3]), load(&f[4]), load(&f[5])];
-        let (tmin, tmax) = (load(&f[6]), load(&f[7]));
-        let dir = [dx, dy, dz];
+        let org = [load(&f[0]), load(&f[1]), load(&f[2])];
+        let dir = [load(&f[3]), load(&f[4]), load(&f[5])];
+        Self::from_lanes(org, dir, load(&f[6]), load(&f[7]), valid)
+    }
+
+    /// The packet of the rays already in lanes: origins, directions, intervals, and the `valid` lanes (bit `i`
+    /// for lane `i`), which must hold rays with [`Ray::is_valid`]; the other lanes may hold anything finite.
+    #[inline(always)]
+    pub fn from_lanes(org: [V; 3], dir: [V; 3], tmin: V, tmax: V, valid: u32) -> Self {
+        let [dx, dy, dz] = dir;
         let one = V::splat(1.0);
         let inv = [one / dir[0], one / dir[1], one / dir[2]];
         let inf = V::splat(f32::INFINITY);
@@ -112,7 +118,7 @@ impl<V: Vf32> RayPacket<V> {
             _ => None,
         };
         Self {
-            org: [ox, oy, oz],
+            org,
             dir,
             inv,
             finite_inv,
@@ -131,6 +137,14 @@ impl<V: Vf32> RayPacket<V> {
         let c = |v: &[V; 3]| Vec3::new(v[0].lane(i), v[1].lane(i), v[2].lane(i));
         Ray::segment(c(&self.org), c(&self.dir), self.tmin.lane(i), self.tmax.lane(i))
     }
+}
+
+/// `[f(a[0]), f(a[1]), f(a[2])]`. Kernels use it instead of `<[T; 3]>::map`: code that handles vectors must
+/// be inlined into the SIMD entry point to be compiled for its instruction set (see `raylab_simd::dispatch`),
+/// and the standard library's array and iterator helpers are not always inlined.
+#[inline(always)]
+pub(crate) fn map3<T: Copy, U>(a: [T; 3], f: impl Fn(T) -> U) -> [U; 3] {
+    [f(a[0]), f(a[1]), f(a[2])]
 }
 
 /// One field of up to four bundles (MFT's frustums or cones) in the first four lanes, `empty` in the others

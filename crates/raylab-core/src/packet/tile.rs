@@ -4,7 +4,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{Disc, PacketHits, RayPacket};
+use super::{Disc, PacketHits, RayPacket, map3};
 use crate::aabb::Aabb;
 use crate::ray::Ray;
 
@@ -54,9 +54,13 @@ impl<V: Vf32> PacketTile<V> {
                 origin_pixel.push((pw * bx, ph * by));
             }
         }
-        let hits: Vec<PacketHits<V>> = packets.iter().map(PacketHits::new).collect();
-        let farthest_hit =
-            packets.iter().map(|p| V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max()).collect();
+        // Plain loops: vector code must be inlined into the SIMD entry point (see `map3`).
+        let mut hits = Vec::with_capacity(packets.len());
+        let mut farthest_hit = Vec::with_capacity(packets.len());
+        for p in &packets {
+            hits.push(PacketHits::new(p));
+            farthest_hit.push(V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max());
+        }
         Self { packets, hits, farthest_hit, origin_pixel, cols, rows, width, height }
     }
 
@@ -289,10 +293,10 @@ impl Frustum {
         }
         let mut f = Frustum {
             origin,
-            pos_near: pos_near.map(|v| v.reduce_min()),
-            pos_far: pos_far.map(|v| v.reduce_max()),
-            neg_near: neg_near.map(|v| v.reduce_max()),
-            neg_far: neg_far.map(|v| v.reduce_min()),
+            pos_near: map3(pos_near, V::reduce_min),
+            pos_far: map3(pos_far, V::reduce_max),
+            neg_near: map3(neg_near, V::reduce_max),
+            neg_far: map3(neg_far, V::reduce_min),
             t_min: t_min.reduce_min().max(0.0),
             t_max: t_max.reduce_max(),
             origin_slack: 0.0,

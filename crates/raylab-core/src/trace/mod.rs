@@ -506,14 +506,17 @@ impl Kernel for OccludedSimd<'_, '_> {
 /// The origin shared by every valid ray of packets `set`, if there is one.
 #[inline(always)]
 fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Vec3> {
-    let origin = set
-        .iter()
-        .find_map(|&j| {
-            let p = &tile.packets[j];
-            let first = p.valid.bits().trailing_zeros() as usize;
-            (first < V::LANES).then(|| p.ray(first))
-        })?
-        .origin;
+    // A plain loop rather than `find_map`, so the vector code stays inlined (see `map3`).
+    let mut found = None;
+    for &j in set {
+        let p = &tile.packets[j];
+        let first = p.valid.bits().trailing_zeros() as usize;
+        if first < V::LANES {
+            found = Some(p.ray(first).origin);
+            break;
+        }
+    }
+    let origin = found?;
     let o = [V::splat(origin.x), V::splat(origin.y), V::splat(origin.z)];
     let mut elsewhere = 0;
     for &j in set {
