@@ -4,8 +4,8 @@
 //! A node classifies its rays against both children's boxes in one pass, loading each ray into SIMD lanes
 //! once. The box test runs on four or eight rays at once in SIMD lanes ([`Vf32`], the backend's widest, run
 //! through [`raylab_simd::dispatch`]): each axis's entry and exit are taken in
-//! the order the direction's sign gives and merged with comparisons that ignore NaN, so a zero direction
-//! component with the origin on a slab plane (`0 * inf`) leaves that axis unconstrained. Boxes are padded by a
+//! the order the direction's sign gives and merged by `max`/`min`, whose SSE rule ignores a NaN first operand, so
+//! a zero direction component with the origin on a slab plane (`0 * inf`) leaves that axis unconstrained. Boxes are padded by a
 //! few ulps of their coordinates and far distances widened, so rounding never drops a ray that touches a
 //! triangle inside: filtering may keep extra rays, never lose one.
 
@@ -102,9 +102,10 @@ fn classify_lanes<V: Vf32, const N: usize>(rays: &[RayRecord], boxes: &[FilterBo
                 let hi = (bmax[a] - org[a]) * inv[a];
                 let enter = V::select(neg[a], hi, lo);
                 let leave = V::select(neg[a], lo, hi);
-                // A NaN (origin on the plane, zero direction) fails both comparisons and changes nothing.
-                near = V::select(enter.gt(near), enter, near);
-                far = V::select(leave.lt(far), leave, far);
+                // `max`/`min` return their second operand when the first is NaN (origin on the plane, zero
+                // direction), so such an axis changes nothing.
+                near = enter.max(near);
+                far = leave.min(far);
             }
             let bits = near.le(far + far.abs() * slack).bits() as usize;
             bytes |= (u64::from(SPREAD[bits & 15]) | u64::from(SPREAD[bits >> 4 & 15]) << 32) << k;
