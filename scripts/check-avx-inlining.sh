@@ -7,7 +7,7 @@
 #   scripts/check-avx-inlining.sh
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-cargo build --release -p raylab-bench --manifest-path "$root/Cargo.toml"
+cargo build --release --locked -p raylab-bench --manifest-path "$root/Cargo.toml"
 found=$(objdump -d --no-show-raw-insn -C "$root/target/release/raylab-bench" |
   awk '/^[0-9a-f]+ <.*>:$/ { fn = $0 } /call.*core_arch::x86::avx/ { print fn }' | sort | uniq -c)
 if [ -n "$found" ]; then
