@@ -45,9 +45,10 @@ impl VMask for M32x8 {
     }
 }
 
-macro_rules! mask_op {
-    ($trait:ident, $f:ident, $intr:ident) => {
-        impl $trait for M32x8 {
+/// `impl $trait for $ty` by one two-operand intrinsic on the registers.
+macro_rules! binop {
+    ($ty:ident, $trait:ident, $f:ident, $intr:ident) => {
+        impl $trait for $ty {
             type Output = Self;
             #[inline(always)]
             fn $f(self, o: Self) -> Self {
@@ -57,9 +58,9 @@ macro_rules! mask_op {
     };
 }
 
-mask_op!(BitAnd, bitand, _mm256_and_ps);
-mask_op!(BitOr, bitor, _mm256_or_ps);
-mask_op!(BitXor, bitxor, _mm256_xor_ps);
+binop!(M32x8, BitAnd, bitand, _mm256_and_ps);
+binop!(M32x8, BitOr, bitor, _mm256_or_ps);
+binop!(M32x8, BitXor, bitxor, _mm256_xor_ps);
 
 impl Not for M32x8 {
     type Output = Self;
@@ -69,22 +70,10 @@ impl Not for M32x8 {
     }
 }
 
-macro_rules! arith {
-    ($trait:ident, $f:ident, $intr:ident) => {
-        impl $trait for F32x8 {
-            type Output = Self;
-            #[inline(always)]
-            fn $f(self, o: Self) -> Self {
-                Self(avx!($intr(self.0, o.0)))
-            }
-        }
-    };
-}
-
-arith!(Add, add, _mm256_add_ps);
-arith!(Sub, sub, _mm256_sub_ps);
-arith!(Mul, mul, _mm256_mul_ps);
-arith!(Div, div, _mm256_div_ps);
+binop!(F32x8, Add, add, _mm256_add_ps);
+binop!(F32x8, Sub, sub, _mm256_sub_ps);
+binop!(F32x8, Mul, mul, _mm256_mul_ps);
+binop!(F32x8, Div, div, _mm256_div_ps);
 
 impl F32x8 {
     /// The lanes as an array.
