@@ -7,6 +7,7 @@ use raylab_core::dacrt::Dacrt;
 use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
+use raylab_core::packet::MAX_LANES;
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
 use raylab_core::render::{RenderSettings, ShadowTracer, render, surface_epsilon};
@@ -16,6 +17,7 @@ use raylab_core::stats::TraversalStats;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::builtin::{self, Detail};
 use raylab_scene::mesh::{Jitter, MeshBuilder};
+use raylab_simd::Backend;
 
 /// The methods compared with mono (the MBVH's single rays and DACRT's sets included).
 const COHERENT: [Method; 7] =
@@ -144,6 +146,54 @@ fn kd_edge_widths_match_brute_force() {
             }
         }
         assert!(partial > 10, "{name}: only {partial} penumbra rays; the test says little");
+    }
+}
+
+/// Edge-width walks traced in packets (every SIMD backend) give each ray the occlusion of its single walk:
+/// random segments in all directions (packets of one sign class), segments converging on a light (the
+/// renderer's case), axis-parallel ones with zero and negative-zero components, and segments starting on a
+/// scene's bounding planes.
+#[test]
+fn packet_edge_widths_equal_single_walks() {
+    for name in ["atrium", "arena", "kitchen", "forest"] {
+        let scene = builtin::build(name, Detail::Test).unwrap();
+        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let b = scene.bounds();
+        let mut rng = Jitter::new(11);
+        let mut point =
+            || Vec3::new(rng.range(b.min.x, b.max.x), rng.range(b.min.y, b.max.y), rng.range(b.min.z, b.max.z));
+        let segment = |from: Vec3, to: Vec3| {
+            let d = to - from;
+            Ray::segment(from, d / d.length(), 0.0, d.length())
+        };
+        let mut rays: Vec<Ray> = (0..1500).map(|_| segment(point(), point())).collect();
+        let light = point();
+        rays.extend((0..1500).map(|_| segment(point(), light)));
+        for dir in [Vec3::X, Vec3::NEG_Y, Vec3::Z, Vec3::new(-0.0, 1.0, 0.0), Vec3::new(0.0, -0.0, -1.0)] {
+            rays.extend((0..200).map(|_| Ray::segment(point(), dir, 0.0, b.diagonal())));
+        }
+        rays.extend((0..200).map(|_| {
+            let mut from = point();
+            from.x = b.min.x;
+            segment(from, point())
+        }));
+        let mut s = TraversalStats::default();
+        for leak_fix in [false, true] {
+            let mut single = EdgeWidth::new(b.diagonal() * 0.02, leak_fix);
+            let want: Vec<f32> = rays.iter().map(|r| tree.edge_width(r, &mut single, &mut s)).collect();
+            let partial = want.iter().filter(|&&w| w > 0.0 && w < 1.0).count();
+            assert!(partial > 10, "{name}: only {partial} penumbra rays; the test says little");
+            for backend in Backend::available() {
+                let tracer =
+                    Tracer::new(&tree, None, TraceOptions { method: Method::Packet, backend, ..Default::default() });
+                let mut states = vec![single.clone(); MAX_LANES];
+                let mut got = vec![-1.0; rays.len()];
+                tracer.edge_widths(&rays, &mut states, &mut got, &mut s);
+                for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+                    assert_eq!(g, w, "{name} {backend:?} ray {i} {:?} (leak fix {leak_fix})", rays[i]);
+                }
+            }
+        }
     }
 }
 

@@ -56,8 +56,17 @@ impl Frontend {
         self.last_tick = started;
         lab.set_window_size(size.0, size.1);
         lab.tick(dt);
-        if lab.settings.mode == RenderMode::Hybrid {
-            self.hybrid.get_or_insert_with(|| HybridGpu::new(&self.gpu.device)).step(&self.gpu, lab);
+        if lab.settings.mode == RenderMode::Hybrid && self.hybrid.is_none() {
+            match HybridGpu::new(&self.gpu) {
+                Ok(h) => self.hybrid = Some(h),
+                Err(e) => {
+                    lab.message(e, true);
+                    lab.settings.mode = RenderMode::Whitted;
+                }
+            }
+        }
+        if let Some(h) = self.hybrid.as_mut().filter(|_| lab.settings.mode == RenderMode::Hybrid) {
+            h.step(&self.gpu, lab);
         }
         let fresh = lab.poll().map(|r| (r.hybrid.clone(), r.frame.width, r.frame.height));
         let upload_ms = match fresh {

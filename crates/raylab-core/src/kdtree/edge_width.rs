@@ -1,10 +1,22 @@
-//! Edge-width shadow rays through the kd-tree (Tsakok 2008, Listing 5.1).
+//! Edge-width shadow rays through the kd-tree (Tsakok 2008, Listing 5.1), one at a time or in packets.
 //!
-//! The walk is the single-ray traversal; only leaves differ. Every triangle of a leaf is tested without
+//! A walk is the ordinary traversal; only leaves differ. Every triangle of a leaf is tested without
 //! culling (entries and exits both matter), its crossings go to the [`EdgeWidth`] state, and the crossings up
 //! to the leaf's far end are committed in order. Leaves come front to back, so the walk can stop as soon as a
 //! chord reaches the radius.
+//!
+//! Packet walks trace several such rays together: each lane has its own state and its own leaf intervals,
+//! and lanes stop one by one. The pairing needs every lane's leaves in its own distance order, so a packet
+//! holds only rays whose directions share signs and descends near child first by those signs
+//! ([`Front::Signs`]). A lane's crossings are those the single walk finds (the packet triangle test repeats
+//! the scalar test's arithmetic per lane), so both give the same occlusion.
 
+use std::ops::Range;
+
+use glam::Vec3;
+use raylab_simd::{VMask, Vf32};
+
+use crate::packet::{MAX_LANES, RayPacket, crossing_packet};
 use crate::ray::Ray;
 use crate::shadow::{Crossing, EdgeWidth};
 use crate::stats::TraversalStats;
@@ -12,6 +24,7 @@ use crate::triangle::RayShear;
 
 use super::KdTree;
 use super::mono::{Next, SPLIT_SLACK};
+use super::packet::{Front, PacketLeaf};
 
 impl KdTree {
     /// Traces an edge-width shadow ray (from the shaded point toward the light) and returns its occlusion in
@@ -38,5 +51,103 @@ impl KdTree {
         stats.isect_tests += tests;
         state.commit(f32::INFINITY, tris);
         state.occlusion()
+    }
+
+    /// The edge-width occlusions of `rays`, written to `out`, traced in packets of `V::LANES` rays whose
+    /// directions share signs; `states` (at least `V::LANES`, all with the same radius and leak-fix switch)
+    /// are the lanes' reusable states. Equal, ray by ray, to [`KdTree::edge_width`].
+    #[inline(always)]
+    pub fn edge_widths<V: Vf32>(
+        &self,
+        rays: &[Ray],
+        states: &mut [EdgeWidth],
+        out: &mut [f32],
+        stats: &mut TraversalStats,
+    ) {
+        assert!(rays.len() == out.len() && states.len() >= V::LANES);
+        // Rays grouped by direction signs, keeping their order (neighbours are coherent) within a group.
+        let mut order: Vec<(usize, u32)> = rays.iter().map(|r| signs(r.dir)).enumerate().collect();
+        order.sort_by_key(|&(_, s)| s);
+        let mut start = 0;
+        while start < order.len() {
+            let sign = order[start].1;
+            let mut end = start + 1;
+            while end < order.len() && end - start < V::LANES && order[end].1 == sign {
+                end += 1;
+            }
+            let group = &order[start..end];
+            let mut lanes = [None; MAX_LANES];
+            for (lane, &(i, _)) in lanes.iter_mut().zip(group) {
+                *lane = Some(rays[i]);
+            }
+            let p = RayPacket::<V>::new(&lanes[..V::LANES]);
+            let states = &mut states[..group.len()];
+            for s in states.iter_mut() {
+                s.begin();
+            }
+            stats.rays += group.len() as u64;
+            stats.packets += 1;
+            let mut walk = EdgeWalks { tree: self, p: &p, states: &mut *states, tests: 0 };
+            self.traverse_packet(&p, Front::Signs(sign as usize), stats, &mut walk);
+            stats.isect_tests += walk.tests;
+            for (s, &(i, _)) in states.iter_mut().zip(group) {
+                s.commit(f32::INFINITY, self.triangles());
+                out[i] = s.occlusion();
+            }
+            start = end;
+        }
+    }
+}
+
+/// Bit `k` set when `dir`'s component `k` is negative (including -0, whose inverse is -infinity).
+fn signs(dir: Vec3) -> u32 {
+    dir.is_negative_bitmask()
+}
+
+/// The edge-width walks of a packet's lanes, one state per lane.
+struct EdgeWalks<'a, V: Vf32> {
+    tree: &'a KdTree,
+    p: &'a RayPacket<V>,
+    states: &'a mut [EdgeWidth],
+    tests: u64,
+}
+
+impl<V: Vf32> PacketLeaf<V> for EdgeWalks<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, ids: Range<usize>, active: V::Mask, t_far: V) -> (V, V::Mask) {
+        let tris = self.tree.triangles();
+        let mut t = [0.0f32; MAX_LANES];
+        for &id in &self.tree.tri_ids()[ids] {
+            self.tests += 1;
+            let corners = tris.get(id);
+            let (hit, t_hit) = crossing_packet(self.p, corners, active);
+            if hit.none() {
+                continue;
+            }
+            t_hit.write_to(&mut t[..V::LANES]);
+            let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+            let mut bits = hit.bits();
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let state = &mut self.states[i];
+                if !state.seen(id) {
+                    let dir = Vec3::new(self.p.dir[0].lane(i), self.p.dir[1].lane(i), self.p.dir[2].lane(i));
+                    state.add(Crossing { t: t[i], tri: id, front: n.dot(dir) < 0.0 });
+                }
+            }
+        }
+        let mut far = [0.0f32; MAX_LANES];
+        t_far.write_to(&mut far[..V::LANES]);
+        let mut finished = 0u32;
+        let mut bits = active.bits();
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if self.states[i].commit(far[i] * (1.0 + SPLIT_SLACK), tris) {
+                finished |= 1 << i;
+            }
+        }
+        (self.p.tmax, V::Mask::from_bits(finished))
     }
 }

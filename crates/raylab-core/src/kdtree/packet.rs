@@ -7,6 +7,10 @@
 //! packets of secondary rays with different origins stay exact. Each lane keeps an interval `[t_near,
 //! t_far]`; a child is entered when any lane's interval in it is non-empty, and a popped cell is skipped
 //! when every lane's part of it starts beyond that lane's closest hit.
+//!
+//! Edge-width walks need each lane's leaves front to back, which the origin rule does not give when lanes
+//! start on both sides of a plane; their packets share direction signs and take the near child by sign
+//! ([`Front::Signs`]), the classic rule, under which every lane's cells come in its own distance order.
 
 use raylab_simd::{VMask, Vf32};
 
@@ -24,10 +28,20 @@ struct Entry<V: Vf32> {
 
 /// What a packet walk does at a leaf. A trait rather than a closure so that it is always inlined into the
 /// walk, and so compiled with the kernel's target features (see [`raylab_simd::Kernel`]).
-trait PacketLeaf<V: Vf32> {
-    /// Tests the leaf's triangles `ids` for the `active` lanes; returns each lane's current limit (its
-    /// closest hit, or `tmax`) and the lanes that are finished.
-    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask) -> (V, V::Mask);
+pub(super) trait PacketLeaf<V: Vf32> {
+    /// Tests the leaf's triangles `ids` for the `active` lanes, whose intervals in the leaf end at `t_far`;
+    /// returns each lane's current limit (its closest hit, or `tmax`) and the lanes that are finished.
+    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask, t_far: V) -> (V, V::Mask);
+}
+
+/// Which child of an inner node a packet enters first.
+#[derive(Clone, Copy)]
+pub(super) enum Front {
+    /// The child on the first active lane's origin side (Listing 4.1; any mix of directions).
+    Origin,
+    /// The child the shared direction signs meet first: bit `k` set when every lane's direction is
+    /// negative on axis `k` (clear when every lane's is positive), as the sign of its inverse says.
+    Signs(usize),
 }
 
 /// Closest hits, kept in `hits`.
@@ -40,7 +54,7 @@ struct ClosestHits<'a, V: Vf32> {
 
 impl<V: Vf32> PacketLeaf<V> for ClosestHits<'_, V> {
     #[inline(always)]
-    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask) -> (V, V::Mask) {
+    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask, _: V) -> (V, V::Mask) {
         for &id in &self.tree.tri_ids()[ids] {
             self.tests += 1;
             intersect_packet(self.p, self.hits, self.tree.triangles().get(id), id, active);
@@ -59,7 +73,7 @@ struct Blockers<'a, V: Vf32> {
 
 impl<V: Vf32> PacketLeaf<V> for Blockers<'_, V> {
     #[inline(always)]
-    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask) -> (V, V::Mask) {
+    fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask, _: V) -> (V, V::Mask) {
         let mut open = active & !self.blocked;
         for &id in &self.tree.tri_ids()[ids] {
             if open.none() {
@@ -94,7 +108,7 @@ impl KdTree {
     #[inline(always)]
     pub fn intersect_packet<V: Vf32>(&self, p: &RayPacket<V>, hits: &mut PacketHits<V>, stats: &mut TraversalStats) {
         let mut leaf = ClosestHits { tree: self, p, hits, tests: 0 };
-        self.traverse_packet(p, stats, &mut leaf);
+        self.traverse_packet(p, Front::Origin, stats, &mut leaf);
         stats.isect_tests += leaf.tests;
     }
 
@@ -102,14 +116,20 @@ impl KdTree {
     #[inline(always)]
     pub fn occluded_packet<V: Vf32>(&self, p: &RayPacket<V>, stats: &mut TraversalStats) -> V::Mask {
         let mut leaf = Blockers { tree: self, p, blocked: V::Mask::from_bits(0), tests: 0 };
-        self.traverse_packet(p, stats, &mut leaf);
+        self.traverse_packet(p, Front::Origin, stats, &mut leaf);
         stats.isect_tests += leaf.tests;
         leaf.blocked
     }
 
-    /// Walks the leaves the packet's rays cross, handing each to `leaf`.
+    /// Walks the leaves the packet's rays cross, handing each to `leaf`; `front` picks the child entered first.
     #[inline(always)]
-    fn traverse_packet<V: Vf32>(&self, p: &RayPacket<V>, stats: &mut TraversalStats, leaf: &mut impl PacketLeaf<V>) {
+    pub(super) fn traverse_packet<V: Vf32>(
+        &self,
+        p: &RayPacket<V>,
+        front: Front,
+        stats: &mut TraversalStats,
+        leaf: &mut impl PacketLeaf<V>,
+    ) {
         if self.triangles().is_empty() || p.valid.none() {
             return;
         }
@@ -137,9 +157,13 @@ impl KdTree {
                 // Modification 2: the front child is on the origin's side; the first active lane decides
                 // for the packet, and lanes with origins on the other side swap their two intervals.
                 // An origin on the plane belongs to the side its ray leaves (crossing at t = 0 into the other).
+                // Under shared signs the near child is the front one, and a lane starting beyond the plane
+                // (which it never reaches) has all its interval in the far child.
                 let origin_right = dist.lt(zero) | (dist.eq(zero) & p.dir[axis].lt(zero));
-                let leader = active.bits().trailing_zeros();
-                let front_right = origin_right.bits() >> leader & 1 == 1;
+                let front_right = match front {
+                    Front::Origin => origin_right.bits() >> active.bits().trailing_zeros() & 1 == 1,
+                    Front::Signs(neg) => (neg >> axis) & 1 == 1,
+                };
                 let same = if front_right { origin_right } else { !origin_right };
                 let before = d.min(t_far);
                 let after = d.max(t_near);
@@ -167,7 +191,7 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let (limit, finished) = leaf.visit(n.leaf_range(), active & !done);
+            let (limit, finished) = leaf.visit(n.leaf_range(), active & !done, t_far);
             done = done | finished;
             if (p.valid & !done).none() {
                 break;

@@ -14,7 +14,7 @@ use crate::ray::{Hit, Ray};
 pub use cone::{Cone, Cone4};
 pub use disc::Disc;
 pub use tile::{Bundle, Bundle4, Frustum, PacketTile, overlaps_box, slab_interval};
-pub(crate) use woop::sheared_test;
+pub(crate) use woop::{crossing_packet, sheared_test};
 pub use woop::{intersect_packet, occlude_packet};
 
 /// Most lanes a packet may have (8 for AVX).

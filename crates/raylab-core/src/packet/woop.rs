@@ -148,6 +148,14 @@ pub fn intersect_packet<V: Vf32>(
     r.mask
 }
 
+/// The `active` lanes that meet triangle `tri` within `(tmin, tmax]`, and their distances (for edge-width
+/// walks, which want every crossing, not the closest).
+#[inline(always)]
+pub(crate) fn crossing_packet<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask) -> (V::Mask, V) {
+    let r = test(p, tri, active, p.tmax);
+    (r.mask, r.t)
+}
+
 /// The `active` lanes that triangle `tri` blocks within `(tmin, tmax]`.
 #[inline(always)]
 pub fn occlude_packet<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask) -> V::Mask {

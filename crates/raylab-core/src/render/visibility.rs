@@ -1,11 +1,13 @@
 //! How much of the light each hit of a layer sees, under the frame's shadow technique ([`Shadows`]).
 //!
 //! Hard shadows go through the frame's traversal method as one tile of segments ending at the light (so the
-//! frustum methods trace them as frustums from the light, as the thesis does); the shadow cache and edge
-//! widths are single-ray techniques (DACRT, which traces sets, consults the cache for a whole layer at once);
-//! multi-sampling traces each point's samples as one bundle: plain packets, a pyramid fitted to them, or a
+//! frustum methods trace them as frustums from the light, as the thesis does); the shadow cache is a
+//! single-ray technique (DACRT, which traces sets, consults the cache for a whole layer at once); edge widths
+//! start as hard shadows, and the blocked segments then walk the kd-tree for their widths, in packets except
+//! under the single-ray methods; multi-sampling traces each point's samples as one bundle: plain packets, a pyramid fitted to them, or a
 //! pyramid or cone around the light built before the samples ([`crate::trace::Proxy`]).
 
+use crate::packet::MAX_LANES;
 use crate::ray::{Hit, Ray};
 use crate::scene::{PointLight, Scene};
 use crate::shadow::{EdgeWidth, LightSamples, ShadowCache, Shadows};
@@ -19,10 +21,12 @@ use super::shade::{Surface, shadow_ray};
 #[derive(Default)]
 pub struct ShadowScratch {
     cache: ShadowCache,
-    edge: Option<EdgeWidth>,
+    edge: Vec<EdgeWidth>,
     samples: LightSamples,
     rays: Vec<Option<Ray>>,
     blocked: Vec<bool>,
+    walks: Vec<Ray>,
+    widths: Vec<f32>,
 }
 
 /// Traces the shadow rays of hit points under one technique.
@@ -102,14 +106,22 @@ impl ShadowTracer<'_> {
                 // A segment nothing blocks has no crossing and a visibility of 1: the frame's method finds
                 // those as hard shadows, coherently, and only the blocked ones walk the tree for edge widths.
                 self.hard(surfaces, (width, height), stats, sc);
-                let edge = sc.edge.get_or_insert_with(|| EdgeWidth::new(radius, leak_fix));
+                if sc.edge.is_empty() {
+                    sc.edge = vec![EdgeWidth::new(radius, leak_fix); MAX_LANES];
+                }
+                sc.walks.clear();
+                sc.walks.extend(sc.rays.iter().zip(&sc.blocked).filter_map(|(r, &b)| r.filter(|_| b)));
+                sc.widths.clear();
+                sc.widths.resize(sc.walks.len(), 0.0);
+                self.tracer.edge_widths(&sc.walks, &mut sc.edge, &mut sc.widths, stats);
+                let mut widths = sc.widths.iter();
                 sc.rays
                     .iter()
                     .zip(&sc.blocked)
-                    .map(|(r, &blocked)| match r {
-                        Some(r) if blocked => 1.0 - self.tracer.edge_width(r, edge, stats),
-                        Some(_) => 1.0,
-                        None => 0.0,
+                    .map(|(r, &blocked)| match (r, blocked) {
+                        (Some(_), true) => 1.0 - widths.next().copied().unwrap_or(1.0),
+                        (Some(_), false) => 1.0,
+                        (None, _) => 0.0,
                     })
                     .collect()
             }

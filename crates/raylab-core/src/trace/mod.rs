@@ -161,14 +161,32 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// The edge-width occlusion of a single shadow ray (thesis Listing 5.1). Edge-width rays are traced one
-    /// at a time by every method: the kd-tree kernel (also for the MBVH and DACRT methods, which do not visit
-    /// leaves in distance order, which the pairing relies on), or the brute-force reference for
-    /// [`Method::Reference`].
+    /// The edge-width occlusion of a single shadow ray (thesis Listing 5.1): the kd-tree's walk for every
+    /// method (also for the MBVH and DACRT methods, which do not visit leaves in distance order, which the
+    /// pairing relies on), or the brute-force reference for [`Method::Reference`].
     pub fn edge_width(&self, ray: &Ray, state: &mut EdgeWidth, stats: &mut TraversalStats) -> f32 {
         match self.options.method {
             Method::Reference => self.reference().edge_width(ray, state, stats),
             _ => self.tree.edge_width(ray, state, stats),
+        }
+    }
+
+    /// The edge-width occlusions of `rays`, written to `out`; `states` holds at least
+    /// [`crate::packet::MAX_LANES`] states with the frame's radius and leak-fix switch. The single-ray
+    /// methods walk ray by ray (the reference by brute force); the others trace the walks as kd-tree packets
+    /// of rays with the same direction signs (see [`KdTree::edge_widths`]), which give the same answers.
+    pub fn edge_widths(&self, rays: &[Ray], states: &mut [EdgeWidth], out: &mut [f32], stats: &mut TraversalStats) {
+        assert_eq!(rays.len(), out.len());
+        match self.options.method {
+            Method::Reference | Method::Mono => {
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = self.edge_width(r, &mut states[0], stats);
+                }
+            }
+            _ => raylab_simd::dispatch(
+                self.options.backend,
+                EdgeWidthsSimd { tree: self.tree, rays, states, out, stats },
+            ),
         }
     }
 
@@ -500,6 +518,23 @@ impl Kernel for OccludedSimd<'_, '_> {
     #[inline(always)]
     fn run<V: Vf32>(self) {
         self.tracer.occluded_simd::<V>(self.rays, self.width, self.height, self.toward, self.out, self.stats);
+    }
+}
+
+/// [`KdTree::edge_widths`] as a [`Kernel`].
+struct EdgeWidthsSimd<'t> {
+    tree: &'t KdTree,
+    rays: &'t [Ray],
+    states: &'t mut [EdgeWidth],
+    out: &'t mut [f32],
+    stats: &'t mut TraversalStats,
+}
+
+impl Kernel for EdgeWidthsSimd<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Vf32>(self) {
+        self.tree.edge_widths::<V>(self.rays, self.states, self.out, self.stats);
     }
 }
 

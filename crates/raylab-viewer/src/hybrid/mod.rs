@@ -51,16 +51,26 @@ pub struct HybridGpu {
 }
 
 impl HybridGpu {
-    /// The passes, with no scene yet.
-    pub fn new(device: &wgpu::Device) -> Self {
-        Self {
-            gbuffer: GBufferPass::new(device),
+    /// The passes, with no scene yet; an error naming the adapter when it cannot render into the G-buffer's
+    /// 32-bit float targets (some OpenGL drivers cannot), so the mode is refused instead of failing.
+    pub fn new(gpu: &Gpu) -> Result<Self, String> {
+        let usages = gpu.adapter.get_texture_format_features(gbuffer::TARGET_FORMAT).allowed_usages;
+        if !usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
+            return Err(format!(
+                "hybrid mode needs a GPU that renders into {:?} targets, and {} cannot; staying in the CPU modes \
+                 (with no GPU, Mesa's lavapipe Vulkan driver can: apt-get install mesa-vulkan-drivers libvulkan1)",
+                gbuffer::TARGET_FORMAT,
+                gpu.describe()
+            ));
+        }
+        Ok(Self {
+            gbuffer: GBufferPass::new(&gpu.device),
             readback: Readback::default(),
-            composite: CompositePass::new(device),
+            composite: CompositePass::new(&gpu.device),
             scene: None,
             moving: None,
             in_flight: VecDeque::new(),
-        }
+        })
     }
 
     /// One UI frame's work: rasterise the view `lab` asks for (at most two G-buffers in flight), and hand the
@@ -186,6 +196,7 @@ mod tests {
     #[test]
     fn hybrid_reflections_match_the_cpu_renderer() {
         let gpu = Gpu::new(&Gpu::instance(None), None).expect("a GPU adapter (lavapipe in CI)");
+        super::HybridGpu::new(&gpu).expect("an adapter that renders float targets (lavapipe in CI)");
         let scene = builtin::build("atrium", Detail::Test).unwrap();
         let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
         let tracer = Tracer::new(&tree, None, TraceOptions::default());
