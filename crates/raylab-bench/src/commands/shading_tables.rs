@@ -13,7 +13,7 @@ use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::shadow::{SampleBound, Shadows};
 use raylab_core::trace::{TraceOptions, Tracer};
 
-use super::tables::{Cell, measure};
+use super::tables::{Cell, measure, measure_interleaved};
 
 /// What the shading tables need besides the scenes.
 pub struct ShadingRun<'a> {
@@ -54,12 +54,18 @@ impl ShadingRun<'_> {
         measure(s.scene, tracer, &s.camera, light, &self.settings(shadows, depth, self.size), self.pool, self.reps)
     }
 
+    /// Primary-ray frames (no reflections) under each of `techniques`, measured round by round.
+    fn timed_together(&self, s: &Subject, tracer: &Tracer, light: PointLight, techniques: &[Shadows]) -> Vec<Cell> {
+        let configs: Vec<_> = techniques.iter().map(|&t| self.settings(t, 0, self.size)).collect();
+        measure_interleaved(s.scene, tracer, &s.camera, light, &configs, self.pool, self.reps)
+    }
+
     /// Writes Tables 5.1, 4.6 and 3.1 and the image-quality table for `subjects` into `md`.
     pub fn write(&self, subjects: &[Subject], md: &mut String) -> Result<(), String> {
         let (w, h) = self.size;
         let _ = writeln!(
             md,
-            "\n{w}x{h}; primary rays by MFT {t}x{t}; FPS from the median of {} frames. Soft techniques use the \
+            "\n{w}x{h}; primary rays by MFT {t}x{t}; FPS from the median of {} frames, the techniques of a table row rendered in turn, round by round. Soft techniques use the \
              light's radius (1 where the scene's light is a point), and the edge radius R equals it.",
             self.reps,
             t = self.tile
@@ -91,13 +97,20 @@ impl ShadingRun<'_> {
             let tracer = Self::tracer(s);
             let light = s.light.soft();
             let r = light.radius;
-            let cell = |shadows| self.timed(s, &tracer, light, shadows, 0);
-            let none = cell(Shadows::None);
-            let hard = cell(Shadows::Hard);
-            let cached = cell(Shadows::Cached);
-            let edge = cell(Shadows::EdgeWidth { radius: r, leak_fix: false });
-            let ms4 = cell(Shadows::MultiSample { samples: 4, bound: SampleBound::default() });
-            let ms32 = cell(Shadows::MultiSample { samples: 32, bound: SampleBound::default() });
+            let cells = self.timed_together(
+                s,
+                &tracer,
+                light,
+                &[
+                    Shadows::None,
+                    Shadows::Hard,
+                    Shadows::Cached,
+                    Shadows::EdgeWidth { radius: r, leak_fix: false },
+                    Shadows::MultiSample { samples: 4, bound: SampleBound::default() },
+                    Shadows::MultiSample { samples: 32, bound: SampleBound::default() },
+                ],
+            );
+            let [none, hard, cached, edge, ms4, ms32] = cells[..] else { unreachable!("six techniques") };
             let _ = writeln!(
                 md,
                 "| {} | {:.1} | {:.1} | {:.1} ({:.0}%) | {:.1} | {:.2}x | {:.2} | {:.2} |",
@@ -127,13 +140,10 @@ impl ShadingRun<'_> {
             let tracer = Self::tracer(s);
             for radius in [1.0f32, 2.0] {
                 let light = PointLight { radius, ..s.light };
+                let bounds = [SampleBound::Cone, SampleBound::Pyramid, SampleBound::Fitted, SampleBound::Packets];
+                let techniques = bounds.map(|bound| Shadows::MultiSample { samples: 16, bound });
                 let cells: Vec<(SampleBound, Cell)> =
-                    [SampleBound::Cone, SampleBound::Pyramid, SampleBound::Fitted, SampleBound::Packets]
-                        .into_iter()
-                        .map(|bound| {
-                            (bound, self.timed(s, &tracer, light, Shadows::MultiSample { samples: 16, bound }, 0))
-                        })
-                        .collect();
+                    bounds.into_iter().zip(self.timed_together(s, &tracer, light, &techniques)).collect();
                 let cone = cells[0].1.fps;
                 for (bound, c) in &cells {
                     let speedup =

@@ -12,7 +12,6 @@ use raylab_core::method::Method;
 use raylab_core::render::{RenderSettings, StageTimes, render};
 use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::shadow::Shadows;
-use raylab_core::stats::TraversalStats;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_simd::Backend;
 
@@ -104,29 +103,53 @@ pub fn measure(
     pool: &rayon::ThreadPool,
     reps: u64,
 ) -> Cell {
-    let mut times = Vec::new();
-    let mut stats = TraversalStats::default();
-    let mut stages = StageTimes::default();
+    measure_interleaved(scene, tracer, cam, light, std::slice::from_ref(s), pool, reps)[0]
+}
+
+/// Measures several configurations of one view together: a warm-up frame of each, then `reps` rounds that
+/// render each once, so that a slow spell of a shared machine slows every configuration alike and the ratios
+/// between them (Table 5.1's edge/hard time, Table 4.6's cone speed-up) stay honest.
+pub fn measure_interleaved(
+    scene: &Scene,
+    tracer: &Tracer,
+    cam: &Camera,
+    light: PointLight,
+    configs: &[RenderSettings],
+    pool: &rayon::ThreadPool,
+    reps: u64,
+) -> Vec<Cell> {
+    let mut times = vec![Vec::new(); configs.len()];
+    let mut last = vec![None; configs.len()];
     pool.install(|| {
-        render(scene, tracer, cam, light, s);
+        for s in configs {
+            render(scene, tracer, cam, light, s);
+        }
         for _ in 0..reps {
-            let t0 = Instant::now();
-            let f = render(scene, tracer, cam, light, s);
-            times.push(t0.elapsed().as_secs_f64());
-            stats = f.stats;
-            stages = f.stages;
+            for ((s, t), l) in configs.iter().zip(&mut times).zip(&mut last) {
+                let t0 = Instant::now();
+                let f = render(scene, tracer, cam, light, s);
+                t.push(t0.elapsed().as_secs_f64());
+                *l = Some((f.stats, f.stages));
+            }
         }
     });
-    times.sort_by(f64::total_cmp);
-    let tested = stats.packets_culled + stats.packets_tested;
-    Cell {
-        fps: 1.0 / times[times.len() / 2],
-        n: stats.nodes_per_packet(),
-        i: stats.isects_per_packet(),
-        culled: if tested == 0 { 0.0 } else { 100.0 * stats.packets_culled as f64 / tested as f64 },
-        stages,
-        cache_hit_rate: stats.cache_hit_rate(),
-    }
+    times
+        .iter_mut()
+        .zip(last)
+        .map(|(t, l)| {
+            t.sort_by(f64::total_cmp);
+            let (stats, stages) = l.unwrap_or_default();
+            let tested = stats.packets_culled + stats.packets_tested;
+            Cell {
+                fps: t.get(t.len() / 2).map_or(0.0, |m| 1.0 / m),
+                n: stats.nodes_per_packet(),
+                i: stats.isects_per_packet(),
+                culled: if tested == 0 { 0.0 } else { 100.0 * stats.packets_culled as f64 / tested as f64 },
+                stages,
+                cache_hit_rate: stats.cache_hit_rate(),
+            }
+        })
+        .collect()
 }
 
 fn pct(a: f64, b: f64) -> String {
