@@ -177,6 +177,7 @@ impl<'a> Tracer<'a> {
     /// of rays with the same direction signs (see [`KdTree::edge_widths`]), which give the same answers.
     pub fn edge_widths(&self, rays: &[Ray], states: &mut [EdgeWidth], out: &mut [f32], stats: &mut TraversalStats) {
         assert_eq!(rays.len(), out.len());
+        assert!(states.len() >= crate::packet::MAX_LANES, "edge_widths needs one state per packet lane");
         match self.options.method {
             Method::Reference | Method::Mono => {
                 for (o, r) in out.iter_mut().zip(rays) {
