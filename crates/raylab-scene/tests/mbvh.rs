@@ -195,8 +195,14 @@ fn ray_streams_match_brute_force() {
                 assert_eq!(*b, bf.occluded(&r, &mut TraversalStats::default()), "{name} {label}: {r:?}");
             }
         };
-        for (group, ordered) in [(16, true), (256, true), (256, false), (4096, true)] {
+        // Every backend: eight lanes test two rays per node (a lone last ray of a group included), four one.
+        let cases = Backend::available().into_iter().flat_map(|b| {
+            [(16, true), (256, true), (256, false), (4095, true)].into_iter().map(move |(g, o)| (b, g, o))
+        });
+        for (backend, group, ordered) in cases {
             let opts = TraceOptions { method: Method::MbvhRs, stream_order: ordered, ..TraceOptions::default() };
+            let mut m = m.clone();
+            m.backend = backend;
             let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
             let mut s = TraversalStats::default();
             for chunk in rays.chunks(group) {

@@ -84,6 +84,12 @@ pub trait Vf32:
     /// into one vector per field with a register transpose instead of a load per lane and field. `rows` must
     /// hold at least `LANES` rows.
     fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4];
+    /// The four fields of `LANES / 4` rows, each row's field in every lane of its group of four (`rows[g]`
+    /// in lanes `4g..4g + 4`): several rays' records spread for a test against a four-wide node. `rows` must
+    /// hold at least `LANES / 4` rows.
+    fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4];
+    /// `quad` repeated in every group of four lanes (a four-wide node's planes, once per ray).
+    fn repeat4(quad: &[f32; 4]) -> Self;
     /// Smallest lane (NaN lanes are ignored unless all are NaN).
     #[inline(always)]
     fn reduce_min(self) -> f32 {
@@ -110,8 +116,8 @@ pub enum Backend {
     /// SSE2 on x86-64 (always present there): four lanes.
     Sse,
     /// AVX2 and FMA on x86-64 CPUs that have them (checked at run time): eight lanes for the kernels that
-    /// take any width (4x2 ray packets, DACRT's filter and leaves); the MBVH kernels, whose vectors are its
-    /// four-wide nodes, use SSE with it.
+    /// take any width (4x2 ray packets, DACRT's filter and leaves) and two rays per four-wide node test in
+    /// MBVH ray streams; single-ray MBVH traversal, whose vectors are its four-wide nodes, uses SSE with it.
     Avx2,
 }
 
@@ -242,6 +248,17 @@ mod tests {
             assert_eq!(V::splat(2.5).lane(n - 1), 2.5);
             let rows: Vec<[f32; 4]> = (0..8).map(|i| [i as f32, 10.0 + i as f32, -(i as f32), f32::NAN]).collect();
             let refs: Vec<&[f32; 4]> = rows.iter().collect();
+            let spread = V::splat_rows(&refs);
+            let quad = V::repeat4(&[1.0, 2.0, 3.0, 4.0]);
+            for i in 0..n {
+                let g = i / 4;
+                assert_eq!(
+                    [spread[0].lane(i), spread[1].lane(i), spread[2].lane(i)],
+                    [g as f32, 10.0 + g as f32, -(g as f32)]
+                );
+                assert!(spread[3].lane(i).is_nan());
+                assert_eq!(quad.lane(i), (i % 4 + 1) as f32);
+            }
             let cols = V::transpose_rows(&refs);
             for i in 0..n {
                 assert_eq!(

@@ -131,4 +131,12 @@ impl Vf32 for F32x4 {
     fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
         std::array::from_fn(|c| Self(std::array::from_fn(|i| rows[i][c])))
     }
+    #[inline(always)]
+    fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
+        rows[0].map(Self::splat)
+    }
+    #[inline(always)]
+    fn repeat4(quad: &[f32; 4]) -> Self {
+        Self(*quad)
+    }
 }

@@ -156,4 +156,20 @@ impl Vf32 for F32x4 {
             ]
         })
     }
+    #[inline(always)]
+    fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
+        // SAFETY: the row is a reference to four readable `f32`s and `loadu` has no alignment requirement.
+        let r = unsafe { _mm_loadu_ps(rows[0].as_ptr()) };
+        sse!([
+            Self(_mm_shuffle_ps::<0x00>(r, r)),
+            Self(_mm_shuffle_ps::<0x55>(r, r)),
+            Self(_mm_shuffle_ps::<0xaa>(r, r)),
+            Self(_mm_shuffle_ps::<0xff>(r, r)),
+        ])
+    }
+    #[inline(always)]
+    fn repeat4(quad: &[f32; 4]) -> Self {
+        // SAFETY: `quad` is four readable `f32`s and `loadu` has no alignment requirement.
+        Self(unsafe { _mm_loadu_ps(quad.as_ptr()) })
+    }
 }

@@ -177,4 +177,23 @@ impl Vf32 for F32x8 {
             ]
         })
     }
+    #[inline(always)]
+    fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
+        assert!(rows.len() >= 2);
+        // SAFETY: each row is a reference to four readable `f32`s and `loadu` has no alignment requirement;
+        // AVX is present (see `avx!`).
+        let r = unsafe { _mm256_loadu2_m128(rows[1].as_ptr(), rows[0].as_ptr()) };
+        avx!([
+            Self(_mm256_permute_ps::<0x00>(r)),
+            Self(_mm256_permute_ps::<0x55>(r)),
+            Self(_mm256_permute_ps::<0xaa>(r)),
+            Self(_mm256_permute_ps::<0xff>(r)),
+        ])
+    }
+    #[inline(always)]
+    fn repeat4(quad: &[f32; 4]) -> Self {
+        // SAFETY: `quad` is four readable `f32`s and `loadu` has no alignment requirement; AVX is present (see
+        // `avx!`).
+        Self(unsafe { _mm256_loadu2_m128(quad.as_ptr(), quad.as_ptr()) })
+    }
 }

@@ -20,7 +20,7 @@ use crate::tri4::{self, ShearX4};
 use crate::triangle::RayShear;
 
 /// Relative widening of a box's far distance (pbrt's `1 + 2 gamma(3)`).
-const FAR_SLACK: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON;
+pub(super) const FAR_SLACK: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON;
 /// A ray's origin and inverse direction, splatted for the slab test, and which box side it enters first.
 pub(super) struct RaySlab<V: Vf32> {
     org: [V; 3],

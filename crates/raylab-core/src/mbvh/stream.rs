@@ -10,14 +10,17 @@
 //! Shadow rays leave the stream at their first hit.
 //!
 //! What the box tests read of each ray (origin, inverse direction, `tmin`, current limit) lives in a 32-byte
-//! record apart from the rest, so a 2^12-ray group's box data stays in the L2 cache.
+//! record apart from the rest, so a 2^12-ray group's box data stays in the L2 cache. With eight SIMD lanes
+//! (AVX2) two rays are tested against a node's four boxes at once, each in its own half; leaves still pack
+//! rays four at a time.
 
 use std::ops::Range;
 
-use raylab_simd::{VMask, Vf32};
+use raylab_simd::{Kernel, VMask, Vf32};
 
 use super::Mbvh;
-use super::single::RaySlab;
+use super::node::MbvhNode;
+use super::single::FAR_SLACK;
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
 use crate::ray::{Hit, Ray};
 use crate::stats::TraversalStats;
@@ -38,24 +41,56 @@ struct Task {
 }
 
 /// What the box tests read of a ray, 32 bytes, kept apart from the rest so that a group of 2^12 rays' box
-/// data stays in the L2 cache.
+/// data stays in the L2 cache: two rows of four floats, origin and `tmin`, then inverse direction and the
+/// current far limit (the closest hit so far, or `tmax`; [`BLOCKED`] once a shadow ray is blocked).
 #[derive(Clone, Copy)]
 #[repr(C, align(32))]
 struct Hot {
-    org: [f32; 3],
-    tmin: f32,
-    inv: [f32; 3],
-    /// Current far limit: the closest hit so far (or `tmax`); [`BLOCKED`] once a shadow ray is blocked.
-    best: f32,
+    rows: [[f32; 4]; 2],
 }
 
-/// `Hot::best` of a blocked shadow ray: below every `tmin`, so its box tests all fail.
+/// `Hot`'s far limit of a blocked shadow ray: below every `tmin`, so its box tests all fail.
 const BLOCKED: f32 = f32::NEG_INFINITY;
 
 impl Hot {
-    fn blocked(&self) -> bool {
-        self.best == BLOCKED
+    fn new(ray: &Ray) -> Self {
+        let (o, i) = (ray.origin, ray.inv_dir());
+        Self { rows: [[o.x, o.y, o.z, ray.tmin], [i.x, i.y, i.z, ray.tmax]] }
     }
+
+    fn best(&self) -> f32 {
+        self.rows[1][3]
+    }
+
+    fn best_mut(&mut self) -> &mut f32 {
+        &mut self.rows[1][3]
+    }
+
+    fn blocked(&self) -> bool {
+        self.best() == BLOCKED
+    }
+}
+
+/// Entry distances and hit masks of `B::LANES / 4` rays against the four boxes of `node`, ray `j` in lanes
+/// `4j..4j + 4`: per lane exactly the operations of the single-ray slab test (`RaySlab::test`), the planes
+/// put in entry order by the direction's signs with selects instead of branches, as rays in a group differ.
+#[inline(always)]
+fn test_boxes<B: Vf32>(node: &MbvhNode, rays: &[&Hot]) -> (B, B::Mask) {
+    let [ox, oy, oz, tmin] = B::splat_rows(&[&rays[0].rows[0], &rays[rays.len() - 1].rows[0]]);
+    let [ix, iy, iz, best] = B::splat_rows(&[&rays[0].rows[1], &rays[rays.len() - 1].rows[1]]);
+    let (org, inv) = ([ox, oy, oz], [ix, iy, iz]);
+    let zero = B::splat(0.0);
+    let (mut near, mut far) = (tmin, best);
+    for a in 0..3 {
+        let lo = (B::repeat4(&node.min[a]) - org[a]) * inv[a];
+        let hi = (B::repeat4(&node.max[a]) - org[a]) * inv[a];
+        // An inverse is never NaN or -0 for a valid ray, so "not negative" is its sign bit.
+        let pos = !inv[a].lt(zero);
+        // SSE rule: a NaN entry/exit (origin on the plane, zero direction) keeps the other operand.
+        near = B::select(pos, lo, hi).max(near);
+        far = B::select(pos, hi, lo).min(far);
+    }
+    (near, near.le(far * B::splat(FAR_SLACK)))
 }
 
 /// The rest of a ray's state in a stream.
@@ -75,28 +110,18 @@ impl Mbvh {
         stats: &mut TraversalStats,
     ) {
         let emit = |i: usize, _: &Hot, s: &Slot| out[i] = s.hit;
-        match self.backend {
-            #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
-                self.stream::<raylab_simd::sse::F32x4>(rays, false, ordered, stats, emit)
-            }
-            _ => self.stream::<raylab_simd::scalar::F32x4>(rays, false, ordered, stats, emit),
-        }
+        raylab_simd::dispatch(self.backend, Stream { mbvh: self, rays, shadow: false, ordered, stats, emit });
     }
 
     /// Occlusion of a group of rays traced together; each ray leaves the stream at its first blocker.
     pub fn occluded_stream(&self, rays: &[Option<Ray>], out: &mut [bool], ordered: bool, stats: &mut TraversalStats) {
         let emit = |i: usize, h: &Hot, _: &Slot| out[i] = h.blocked();
-        match self.backend {
-            #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
-                self.stream::<raylab_simd::sse::F32x4>(rays, true, ordered, stats, emit)
-            }
-            _ => self.stream::<raylab_simd::scalar::F32x4>(rays, true, ordered, stats, emit),
-        }
+        raylab_simd::dispatch(self.backend, Stream { mbvh: self, rays, shadow: true, ordered, stats, emit });
     }
 
-    fn stream<V: Vf32>(
+    /// Traces a group with box tests in `B` (one ray per four lanes) and leaf packets in `V` (four lanes).
+    #[inline(always)]
+    fn stream<B: Vf32, V: Vf32>(
         &self,
         rays: &[Option<Ray>],
         shadow: bool,
@@ -105,14 +130,14 @@ impl Mbvh {
         mut emit: impl FnMut(usize, &Hot, &Slot),
     ) {
         assert_eq!(V::LANES, 4, "MBVH RS packs leaf rays four at a time");
+        assert!(B::LANES == 4 || B::LANES == 8, "one or two rays per box test");
         let mut hot: Vec<Hot> = Vec::with_capacity(rays.len());
         let mut slots: Vec<Slot> = Vec::with_capacity(rays.len());
         let mut ids: Vec<u32> = Vec::with_capacity(rays.len());
         for (i, r) in rays.iter().enumerate() {
             let ray = r.unwrap_or(Ray::new(glam::Vec3::ZERO, glam::Vec3::Z));
             let live = r.is_some_and(|r| r.is_valid());
-            let inv = ray.inv_dir().to_array();
-            hot.push(Hot { org: ray.origin.to_array(), tmin: ray.tmin, inv, best: ray.tmax });
+            hot.push(Hot::new(&ray));
             slots.push(Slot { ray, hit: None });
             if live {
                 ids.push(i as u32);
@@ -121,14 +146,15 @@ impl Mbvh {
         stats.rays += ids.len() as u64;
         stats.packets += ids.len().div_ceil(4) as u64;
         if !self.tri_ids.is_empty() && !ids.is_empty() {
-            self.walk_stream::<V>(&mut hot, &mut slots, ids, shadow, ordered, stats);
+            self.walk_stream::<B, V>(&mut hot, &mut slots, ids, shadow, ordered, stats);
         }
         for (i, (h, s)) in hot.iter().zip(&slots).enumerate() {
             emit(i, h, s);
         }
     }
 
-    fn walk_stream<V: Vf32>(
+    #[inline(always)]
+    fn walk_stream<B: Vf32, V: Vf32>(
         &self,
         hot: &mut [Hot],
         slots: &mut [Slot],
@@ -183,23 +209,29 @@ impl Mbvh {
                     stack.resize(top[k] + current.len(), 0);
                 }
             }
-            let mut lengths = V::splat(0.0);
-            for &id in &current {
-                let h = &hot[id as usize];
-                if h.blocked() {
-                    continue;
-                }
-                box_tests += 1;
-                let (near, hit) = RaySlab::<V>::from_parts(h.org, h.inv).test(node, h.tmin, h.best);
-                lengths = lengths + V::select(hit, near, V::splat(0.0));
+            if shadow {
+                current.retain(|&i| !hot[i as usize].blocked());
+            }
+            box_tests += current.len() as u64;
+            let mut lengths = B::splat(0.0);
+            let per_test = B::LANES / 4;
+            for group in current.chunks(per_test) {
+                let rays = [&hot[group[0] as usize], &hot[group[group.len() - 1] as usize]];
+                let (near, hit) = test_boxes::<B>(node, &rays[..per_test]);
+                // A lone last ray fills both halves; only its first counts.
+                let hit = hit & B::Mask::from_bits((1 << (4 * group.len())) - 1);
+                lengths = lengths + B::select(hit, near, B::splat(0.0));
                 let bits = hit.bits();
-                for (k, stack) in lanes.iter_mut().enumerate() {
-                    stack[top[k]] = id;
-                    top[k] += (bits >> k & 1) as usize;
+                for (j, &id) in group.iter().enumerate() {
+                    for (k, stack) in lanes.iter_mut().enumerate() {
+                        stack[top[k]] = id;
+                        top[k] += (bits >> (4 * j + k) & 1) as usize;
+                    }
                 }
             }
-            let mut lengths_out = [0f32; 4];
-            lengths.write_to(&mut lengths_out);
+            let mut sums = [0f32; 8];
+            lengths.write_to(&mut sums[..B::LANES]);
+            let lengths_out: [f32; 4] = std::array::from_fn(|k| sums[k] + sums[k + 4]);
             // Children with the largest accumulated length first on the stack, so the shortest is walked first.
             let mut order = [0usize, 1, 2, 3];
             if ordered {
@@ -237,10 +269,10 @@ impl Mbvh {
         let blocks = tri_slots.len().div_ceil(4) as u64;
         if shadow {
             if self.blocker_in_leaf(&shear, tri_slots, slot.ray.tmin, slot.ray.tmax).0.is_some() {
-                hot.best = BLOCKED;
+                *hot.best_mut() = BLOCKED;
             }
         } else {
-            self.closest_in_leaf(&shear, tri_slots, slot.ray.tmin, &mut hot.best, &mut slot.hit);
+            self.closest_in_leaf(&shear, tri_slots, slot.ray.tmin, hot.best_mut(), &mut slot.hit);
         }
         blocks
     }
@@ -257,7 +289,7 @@ impl Mbvh {
     ) -> u64 {
         let mut rays = [None; 4];
         for (r, &id) in rays.iter_mut().zip(group) {
-            *r = Some(Ray { tmax: hot[id as usize].best, ..slots[id as usize].ray });
+            *r = Some(Ray { tmax: hot[id as usize].best(), ..slots[id as usize].ray });
         }
         let p = RayPacket::<V>::new(&rays[..group.len()]);
         let mut tests = 0;
@@ -273,7 +305,7 @@ impl Mbvh {
             let blocked = p.valid.bits() & !open.bits();
             for (k, &id) in group.iter().enumerate() {
                 if blocked >> k & 1 == 1 {
-                    hot[id as usize].best = BLOCKED;
+                    *hot[id as usize].best_mut() = BLOCKED;
                 }
             }
         } else {
@@ -285,11 +317,35 @@ impl Mbvh {
             let found = hits.to_hits();
             for (k, &id) in group.iter().enumerate() {
                 if let Some(h) = found[k] {
-                    hot[id as usize].best = h.t;
+                    *hot[id as usize].best_mut() = h.t;
                     slots[id as usize].hit = Some(h);
                 }
             }
         }
         tests
+    }
+}
+
+/// A group traced with the backend's lane type ([`raylab_simd::dispatch`]): eight lanes test two rays per node
+/// and leave the leaves to SSE's four, four lanes do both.
+struct Stream<'a, F> {
+    mbvh: &'a Mbvh,
+    rays: &'a [Option<Ray>],
+    shadow: bool,
+    ordered: bool,
+    stats: &'a mut TraversalStats,
+    emit: F,
+}
+
+impl<F: FnMut(usize, &Hot, &Slot)> Kernel for Stream<'_, F> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Vf32>(self) {
+        let Self { mbvh, rays, shadow, ordered, stats, emit } = self;
+        #[cfg(target_arch = "x86_64")]
+        if V::LANES == 8 {
+            return mbvh.stream::<V, raylab_simd::sse::F32x4>(rays, shadow, ordered, stats, emit);
+        }
+        mbvh.stream::<V, V>(rays, shadow, ordered, stats, emit)
     }
 }
