@@ -65,8 +65,9 @@ impl ShadingRun<'_> {
         let (w, h) = self.size;
         let _ = writeln!(
             md,
-            "\n{w}x{h}; primary rays by MFT {t}x{t}; FPS from the median of {} frames, the techniques of a table row rendered in turn, round by round. Soft techniques use the \
-             light's radius (1 where the scene's light is a point), and the edge radius R equals it.",
+            "\n{w}x{h}; primary rays by MFT {t}x{t}; FPS from the median of {} frames, the techniques of a table \
+             row rendered in turn, round by round. Soft techniques use the light's radius (1 where the scene's \
+             light is a point), and the edge radius R equals it.",
             self.reps,
             t = self.tile
         );

@@ -65,8 +65,9 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         assert!(rays.len() == out.len() && states.len() >= V::LANES);
-        // Rays grouped by direction signs, keeping their order (neighbours are coherent) within a group.
-        let mut order: Vec<(usize, u32)> = rays.iter().map(|r| signs(r.dir)).enumerate().collect();
+        // Rays grouped by direction signs (bit k: component k negative, -0 included, as its inverse is
+        // -infinity), keeping their order (neighbours are coherent) within a group.
+        let mut order: Vec<(usize, u32)> = rays.iter().map(|r| r.dir.is_negative_bitmask()).enumerate().collect();
         order.sort_by_key(|&(_, s)| s);
         let mut start = 0;
         while start < order.len() {
@@ -97,11 +98,6 @@ impl KdTree {
             start = end;
         }
     }
-}
-
-/// Bit `k` set when `dir`'s component `k` is negative (including -0, whose inverse is -infinity).
-fn signs(dir: Vec3) -> u32 {
-    dir.is_negative_bitmask()
 }
 
 /// The edge-width walks of a packet's lanes, one state per lane.

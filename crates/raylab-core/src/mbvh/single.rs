@@ -31,12 +31,7 @@ pub(super) struct RaySlab<V: Vf32> {
 
 impl<V: Vf32> RaySlab<V> {
     pub(super) fn new(ray: &Ray) -> Self {
-        Self::from_parts(ray.origin.to_array(), ray.inv_dir().to_array())
-    }
-
-    /// From a ray's origin and inverse direction.
-    #[inline(always)]
-    pub(super) fn from_parts(org: [f32; 3], inv: [f32; 3]) -> Self {
+        let (org, inv) = (ray.origin.to_array(), ray.inv_dir().to_array());
         Self { org: org.map(V::splat), inv: inv.map(V::splat), pos: inv.map(|i| i.is_sign_positive()) }
     }
 
