@@ -93,6 +93,17 @@ fn test_boxes<B: Vf32>(node: &MbvhNode, rays: &[&Hot]) -> (B, B::Mask) {
     (near, near.le(far * B::splat(FAR_SLACK)))
 }
 
+/// Moves the ids of the rays in `ids` not yet blocked to its front, in order; returns how many there are.
+fn keep_open(ids: &mut [u32], hot: &[Hot]) -> usize {
+    let mut open = 0;
+    for r in 0..ids.len() {
+        let id = ids[r];
+        ids[open] = id;
+        open += usize::from(!hot[id as usize].blocked());
+    }
+    open
+}
+
 /// The rest of a ray's state in a stream.
 struct Slot {
     ray: Ray,
@@ -169,18 +180,20 @@ impl Mbvh {
         let mut top = [ids.len(), 0, 0, 0];
         let mut lanes: [Vec<u32>; 4] = [ids, Vec::new(), Vec::new(), Vec::new()];
         let mut tasks: Vec<Task> = vec![Task { child: 0, tris: 0, lane: 0, count: n }];
-        let mut current: Vec<u32> = Vec::new();
         let (mut fetches, mut box_tests, mut leaves, mut tests) = (0u64, 0u64, 0u64, 0u64);
         let (mut leaf_rays, mut slots4, mut slots8, mut slots16) = (0u64, 0u64, 0u64, 0u64);
         while let Some(task) = tasks.pop() {
             let lane = task.lane as usize;
             top[lane] -= task.count as usize;
-            current.clear();
-            current.extend_from_slice(&lanes[lane][top[lane]..top[lane] + task.count as usize]);
+            let start = top[lane];
+            let mut end = start + task.count as usize;
+            if shadow {
+                // Shadow rays blocked since they were queued leave the stream here.
+                end = start + keep_open(&mut lanes[lane][start..end], hot);
+            }
             if task.tris > 0 {
                 leaves += 1;
-                // Shadow rays blocked since they were queued leave the stream here.
-                current.retain(|&i| !hot[i as usize].blocked());
+                let current = &lanes[lane][start..end];
                 let c = current.len() as u64;
                 leaf_rays += c;
                 slots4 += c.div_ceil(4) * 4;
@@ -203,32 +216,39 @@ impl Mbvh {
             }
             fetches += 1;
             let node = &self.nodes[task.child as usize];
-            let start = top;
             for (k, stack) in lanes.iter_mut().enumerate() {
-                if stack.len() < top[k] + current.len() {
-                    stack.resize(top[k] + current.len(), 0);
+                if stack.len() < top[k] + (end - start) {
+                    stack.resize(top[k] + (end - start), 0);
                 }
             }
-            if shadow {
-                current.retain(|&i| !hot[i as usize].blocked());
-            }
-            box_tests += current.len() as u64;
+            box_tests += (end - start) as u64;
+            // The task's rays are read from their lane's stack while the hits are pushed onto all four, in
+            // place: a lane's stack top never passes the next ray to read, since each ray pushes at most one
+            // entry per lane. The tops live in a local copy, indexed only by constants, so they stay in
+            // registers.
+            let mut tops = top;
             let mut lengths = B::splat(0.0);
             let per_test = B::LANES / 4;
-            for group in current.chunks(per_test) {
-                let rays = [&hot[group[0] as usize], &hot[group[group.len() - 1] as usize]];
+            let mut r = start;
+            while r < end {
+                let count = per_test.min(end - r);
+                let group = [lanes[lane][r], lanes[lane][r + count - 1]];
+                let rays = [&hot[group[0] as usize], &hot[group[1] as usize]];
                 let (near, hit) = test_boxes::<B>(node, &rays[..per_test]);
                 // A lone last ray fills both halves; only its first counts.
-                let hit = hit & B::Mask::from_bits((1 << (4 * group.len())) - 1);
+                let hit = hit & B::Mask::from_bits((1 << (4 * count)) - 1);
                 lengths = lengths + B::select(hit, near, B::splat(0.0));
                 let bits = hit.bits();
-                for (j, &id) in group.iter().enumerate() {
+                for (j, &id) in group[..count].iter().enumerate() {
                     for (k, stack) in lanes.iter_mut().enumerate() {
-                        stack[top[k]] = id;
-                        top[k] += (bits >> (4 * j + k) & 1) as usize;
+                        stack[tops[k]] = id;
+                        tops[k] += (bits >> (4 * j + k) & 1) as usize;
                     }
                 }
+                r += count;
             }
+            let pushed: [usize; 4] = std::array::from_fn(|k| tops[k] - top[k]);
+            top = tops;
             let mut sums = [0f32; 8];
             lengths.write_to(&mut sums[..B::LANES]);
             let lengths_out: [f32; 4] = std::array::from_fn(|k| sums[k] + sums[k + 4]);
@@ -247,8 +267,8 @@ impl Mbvh {
                 order = keys.map(|key| 3 - (key & 3) as usize);
             }
             for k in order {
-                let count = (top[k] - start[k]) as u32;
-                if count > 0 {
+                if pushed[k] > 0 {
+                    let count = pushed[k] as u32;
                     tasks.push(Task { child: node.child[k], tris: node.count[k], lane: k as u8, count });
                 }
             }
