@@ -148,7 +148,7 @@ impl<V: Vf32> ShearX4<V> {
     /// Splats `shear`'s constants.
     pub fn new(shear: &RayShear) -> Self {
         let k = shear.axes();
-        let o = shear.origin();
+        let o = shear.origin().to_array();
         let s = shear.shear();
         Self { scalar: *shear, org: k.map(|a| V::splat(o[a])), s: s.map(V::splat), k }
     }

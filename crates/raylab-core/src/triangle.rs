@@ -38,8 +38,9 @@ pub struct TriHit {
 impl RayShear {
     /// Precomputes the shear for `ray`. The ray's direction must not be zero.
     pub fn new(ray: &Ray) -> Self {
-        let d = ray.dir;
-        let a = d.abs();
+        // Indexing an array, not a `Vec3` (whose index is a match), keeps the axis lookups free of branches.
+        let d = ray.dir.to_array();
+        let a = ray.dir.abs();
         let kz = if a.x >= a.y && a.x >= a.z {
             0
         } else if a.y >= a.z {

@@ -19,6 +19,7 @@ fn pick<V: Vf32>(is: [V::Mask; 2], x: V, y: V, z: V) -> V {
 /// Corner `v` relative to the packet's origins, components in `(kx, ky, kz)` order for every lane.
 #[inline(always)]
 fn rel_uniform<V: Vf32>(p: &RayPacket<V>, v: Vec3, [kx, ky, kz]: [usize; 3]) -> (V, V, V) {
+    let v = v.to_array();
     (V::splat(v[kx]) - p.org[kx], V::splat(v[ky]) - p.org[ky], V::splat(v[kz]) - p.org[kz])
 }
 
