@@ -41,11 +41,12 @@ impl Ray {
 
     /// True when every component is finite and the direction is not the zero vector.
     pub fn is_valid(&self) -> bool {
-        self.origin.is_finite()
-            && self.dir.is_finite()
-            && self.dir != Vec3::ZERO
-            && !self.tmin.is_nan()
-            && !self.tmax.is_nan()
+        // `&`, not `&&`: one branch-free test, since packets check every lane.
+        self.origin.is_finite_mask().all()
+            & self.dir.is_finite_mask().all()
+            & (self.dir.abs().max_element() > 0.0)
+            & !self.tmin.is_nan()
+            & !self.tmax.is_nan()
     }
 }
 

@@ -52,17 +52,21 @@ impl<V: Vf32> RayPacket<V> {
     #[inline(always)]
     pub fn new(rays: &[Option<Ray>]) -> Self {
         assert!(rays.len() <= V::LANES && V::LANES <= MAX_LANES);
-        // Gather the raw fields; empty lanes get a harmless ray along +z.
+        Self::gather(rays, |i| (i < rays.len()).then_some(i))
+    }
+
+    /// Packs lane `i` from `rays[index(i)]`, straight from the caller's rays (no copy of them first); a lane
+    /// whose index is `None`, or whose ray is `None` or invalid (NaN, zero direction), stays empty: it holds a
+    /// ray along +z, as [`Self::from_lanes`] accepts.
+    #[inline(always)]
+    pub fn gather(rays: &[Option<Ray>], index: impl Fn(usize) -> Option<usize>) -> Self {
         let mut f = [[0.0f32; MAX_LANES]; 8];
+        f[5] = [1.0; MAX_LANES];
+        f[7] = [f32::INFINITY; MAX_LANES];
         let mut valid = 0u32;
         for i in 0..V::LANES {
-            let r = match rays.get(i).copied().flatten() {
-                Some(r) if r.is_valid() => {
-                    valid |= 1 << i;
-                    r
-                }
-                _ => Ray::new(Vec3::ZERO, Vec3::Z),
-            };
+            let Some(r) = index(i).and_then(|j| rays[j].as_ref()).filter(|r| r.is_valid()) else { continue };
+            valid |= 1 << i;
             let values = [r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z, r.tmin, r.tmax];
             for (field, v) in f.iter_mut().zip(values) {
                 field[i] = v;

@@ -43,14 +43,12 @@ impl<V: Vf32> PacketTile<V> {
         let (cols, rows) = (width.div_ceil(pw), height.div_ceil(ph));
         let mut packets = Vec::with_capacity(cols * rows);
         let mut origin_pixel = Vec::with_capacity(cols * rows);
-        let mut lane_rays = [None; super::MAX_LANES];
         for by in 0..rows {
             for bx in 0..cols {
-                for (i, slot) in lane_rays.iter_mut().enumerate().take(V::LANES) {
+                packets.push(RayPacket::gather(rays, |i| {
                     let (x, y) = (pw * bx + i % pw, ph * by + i / pw);
-                    *slot = if x < width && y < height { rays[y * width + x] } else { None };
-                }
-                packets.push(RayPacket::new(&lane_rays[..V::LANES]));
+                    (x < width && y < height).then(|| y * width + x)
+                }));
                 origin_pixel.push((pw * bx, ph * by));
             }
         }
