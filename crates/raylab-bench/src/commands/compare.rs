@@ -1,5 +1,7 @@
-//! `raylab-bench compare`: the Embree harness and raylab on the same OBJ, view, light and rays, one after
-//! the other in one invocation, printed as one markdown table for `docs/BENCHMARKS.md`.
+//! `raylab-bench compare`: the Embree harness and raylab on the same OBJ, view, light and rays in one
+//! invocation, printed as one markdown table for `docs/BENCHMARKS.md`. The two take turns: the harness builds
+//! next to raylab's builds, and runs each ray kind just before raylab's runs of that kind, so that a host whose
+//! speed drifts over the minutes of a run (a shared machine) skews the ratios as little as it can.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -12,7 +14,8 @@ use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
 use raylab_core::trace::{TraceOptions, Tracer};
-use raylab_core::workload::{RayKind, WorkloadBuilder};
+use raylab_core::scene::Scene;
+use raylab_core::workload::{RayKind, Workload, WorkloadBuilder};
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
@@ -74,13 +77,37 @@ struct EmbreeRow {
     max: f64,
 }
 
+/// What the harness printed over its invocations.
+#[derive(Default)]
 struct EmbreeRun {
     builds: Vec<(u64, f64)>,
     rows: Vec<EmbreeRow>,
     checks: Vec<String>,
 }
 
-fn run_embree(a: &CompareArgs, cam: &raylab_core::scene::Camera, light: glam::Vec3) -> Result<EmbreeRun, String> {
+impl EmbreeRun {
+    /// Adds one invocation's builds and rows, and its checks not seen before (each invocation repeats the
+    /// primary check).
+    fn merge(&mut self, run: EmbreeRun) {
+        self.builds.extend(run.builds);
+        self.rows.extend(run.rows);
+        for check in run.checks {
+            if !self.checks.contains(&check) {
+                self.checks.push(check);
+            }
+        }
+    }
+}
+
+/// Runs the harness for the ray kinds `kinds` (its `--kinds`: `none` only builds) with `builds` builds per
+/// thread count.
+fn run_embree(
+    a: &CompareArgs,
+    cam: &raylab_core::scene::Camera,
+    light: glam::Vec3,
+    kinds: &str,
+    builds: u64,
+) -> Result<EmbreeRun, String> {
     let v = |p: glam::Vec3| format!("{},{},{}", p.x, p.y, p.z);
     let threads: Vec<String> = a.threads.iter().map(u64::to_string).collect();
     let out = Command::new(&a.embree)
@@ -89,15 +116,15 @@ fn run_embree(a: &CompareArgs, cam: &raylab_core::scene::Camera, light: glam::Ve
         .args(["--fov", &cam.vfov_deg.to_string(), "--light", &v(light)])
         .args(["--width", &a.width.to_string(), "--height", &a.height.to_string()])
         .args(["--threads", &threads.join(","), "--reps", &a.reps.to_string()])
-        .args(["--warmup", &a.warmup.to_string(), "--builds", &a.builds.to_string()])
-        .args(["--kinds", "all"])
+        .args(["--warmup", &a.warmup.to_string(), "--builds", &builds.to_string()])
+        .args(["--kinds", kinds])
         .output()
         .map_err(|e| format!("--embree: cannot run {}: {e}", a.embree.display()))?;
     let text = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
         return Err(format!("{} failed: {}{}", a.embree.display(), text, String::from_utf8_lossy(&out.stderr)));
     }
-    let mut run = EmbreeRun { builds: vec![], rows: vec![], checks: vec![] };
+    let mut run = EmbreeRun::default();
     for line in text.lines() {
         if let Some(rest) = line.strip_prefix("build HIGH") {
             // "       1 thread(s): median 0.108 s (min ...)"
@@ -122,7 +149,7 @@ fn run_embree(a: &CompareArgs, cam: &raylab_core::scene::Camera, light: glam::Ve
             run.checks.push(line.trim_start_matches("## ").to_string());
         }
     }
-    if run.rows.is_empty() {
+    if run.rows.is_empty() && kinds != "none" {
         return Err(format!("no CSV rows in the output of {}", a.embree.display()));
     }
     Ok(run)
@@ -133,7 +160,8 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let env = Environment::detect();
     let (scene, _) = load_scene(&a.scene.source())?;
     let (cam, light) = a.scene.camera_and_light(&scene)?;
-    let embree = with_spinner("running the Embree harness", || run_embree(a, &cam, light.position))?;
+    let mut embree = EmbreeRun::default();
+    embree.merge(with_spinner("Embree harness: builds", || run_embree(a, &cam, light.position, "none", a.builds))?);
 
     let params = a.kd.params()?;
     let mut builds = Vec::new();
@@ -152,8 +180,16 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let reference = BruteForce::new(&scene);
     let (w, h) = (a.width as u32, a.height as u32);
     let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree));
+    // Per ray kind: the harness first, then raylab's single rays, then the coherent methods (primary and
+    // shadow rays) or the incoherent ones (diffuse rays).
     let mut ours: Vec<TraceReport> = Vec::new();
+    let mut coherent: Vec<(Method, u64, TraceReport)> = Vec::new();
+    let mut mbvh_builds = Vec::new();
+    let mut dacrt_setup = None;
+    let mut incoherent: Vec<(String, TraceReport)> = Vec::new();
     for kind in RayKind::ALL {
+        let label = format!("Embree harness: {kind} rays");
+        embree.merge(with_spinner(&label, || run_embree(a, &cam, light.position, kind.name(), 1))?);
         let workload = wb.build(kind);
         for &t in &a.threads {
             let tracer = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
@@ -162,12 +198,15 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             validate(&reference, &workload, &results, 256).map_err(|m| format!("validation failed: {m}"))?;
             ours.push(report);
         }
-    }
-
-    // Coherent methods: primary and shadow rays, every tile size for the frustum methods.
-    let mut coherent: Vec<(Method, u64, TraceReport)> = Vec::new();
-    for kind in [RayKind::Primary, RayKind::Shadow] {
-        let workload = wb.build(kind);
+        if kind == RayKind::Diffuse {
+            // Incoherent rays: the MBVH methods (MBVH RS paper) and DACRT (seed 003).
+            if !a.incoherent.is_empty() {
+                let (mbvh_times, setup, rows) = incoherent_runs(a, &scene, &tree, &reference, &workload)?;
+                (mbvh_builds, dacrt_setup, incoherent) = (mbvh_times, setup, rows);
+            }
+            continue;
+        }
+        // Coherent methods: every tile size for the frustum methods.
         for &method in a.methods.iter().filter(|m| m.uses_packets()) {
             let tiles: Vec<u64> = if method.uses_tiles() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
             for &tile in &tiles {
@@ -184,64 +223,6 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                         .map_err(|m| format!("validation failed ({method} tile {tile}): {m}"))?;
                     coherent.push((method, tile, report));
                 }
-            }
-        }
-    }
-
-    // Incoherent rays: the MBVH methods (MBVH RS paper) and DACRT (seed 003) on the diffuse rays.
-    let mut mbvh_builds = Vec::new();
-    let mut dacrt_setup = None;
-    let mut incoherent: Vec<(String, TraceReport)> = Vec::new();
-    if !a.incoherent.is_empty() {
-        let mut mbvh = None;
-        if a.incoherent.iter().any(|m| m.uses_mbvh()) {
-            for &t in &a.threads {
-                let pool =
-                    rayon::ThreadPoolBuilder::new().num_threads(t as usize).build().map_err(|e| e.to_string())?;
-                let mut times = Vec::new();
-                for _ in 0..a.builds {
-                    let built = pool.install(|| Mbvh::build(&scene));
-                    times.push(built.build_time().as_secs_f64());
-                    mbvh = Some(built);
-                }
-                times.sort_by(f64::total_cmp);
-                mbvh_builds.push((t, times[times.len() / 2]));
-            }
-        }
-        let dacrt = a.incoherent.iter().any(|m| m.uses_dacrt()).then(|| Dacrt::new(&scene));
-        dacrt_setup = dacrt.as_ref().map(|d| d.setup_time().as_secs_f64());
-        let workload = wb.build(RayKind::Diffuse);
-        let runs = a.incoherent.iter().flat_map(|&m| {
-            let groups: Vec<Option<u64>> =
-                if m == Method::MbvhRs { a.rs_groups.iter().map(|&g| Some(g)).collect() } else { vec![None] };
-            groups.into_iter().map(move |g| (m, g))
-        });
-        for (method, group) in runs {
-            for &t in &a.threads {
-                let options = TraceOptions { method, stream_group: group.map(|g| g as usize), ..Default::default() };
-                let mut tracer = Tracer::new(&tree, None, options);
-                if let Some(m) = &mbvh {
-                    tracer = tracer.with_mbvh(m);
-                }
-                if let Some(d) = &dacrt {
-                    tracer = tracer.with_dacrt(d);
-                }
-                let tile = match group {
-                    _ if method.uses_dacrt() => DACRT_TILE,
-                    Some(g) => tile_for_group(HARNESS_TILE, g as u32),
-                    None => HARNESS_TILE,
-                };
-                let setup = || drop(Dacrt::new(&scene));
-                let setup = method.uses_dacrt().then_some(&setup as &(dyn Fn() + Sync));
-                let runs = (t as usize, a.warmup as usize, a.reps as usize);
-                let (report, results) = measure(&tracer, &workload, tile, runs, setup)?;
-                validate(&reference, &workload, &results, 256)
-                    .map_err(|m| format!("validation failed ({method}): {m}"))?;
-                let label = match group {
-                    Some(g) => format!("{method} ({g})"),
-                    None => method.to_string(),
-                };
-                incoherent.push((label, report));
             }
         }
     }
@@ -395,4 +376,68 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
     }
     Ok(())
+}
+
+/// MBVH builds per thread count, DACRT's setup time and the incoherent methods' reports on the diffuse rays
+/// `workload`: the MBVH methods (MBVH RS paper, each RS group size) and DACRT (seed 003).
+type Incoherent = (Vec<(u64, f64)>, Option<f64>, Vec<(String, TraceReport)>);
+
+fn incoherent_runs(
+    a: &CompareArgs,
+    scene: &Scene,
+    tree: &KdTree,
+    reference: &BruteForce,
+    workload: &Workload,
+) -> Result<Incoherent, String> {
+    let mut mbvh = None;
+    let mut mbvh_builds = Vec::new();
+    if a.incoherent.iter().any(|m| m.uses_mbvh()) {
+        for &t in &a.threads {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(t as usize).build().map_err(|e| e.to_string())?;
+            let mut times = Vec::new();
+            for _ in 0..a.builds {
+                let built = pool.install(|| Mbvh::build(scene));
+                times.push(built.build_time().as_secs_f64());
+                mbvh = Some(built);
+            }
+            times.sort_by(f64::total_cmp);
+            mbvh_builds.push((t, times[times.len() / 2]));
+        }
+    }
+    let dacrt = a.incoherent.iter().any(|m| m.uses_dacrt()).then(|| Dacrt::new(scene));
+    let dacrt_setup = dacrt.as_ref().map(|d| d.setup_time().as_secs_f64());
+    let runs = a.incoherent.iter().flat_map(|&m| {
+        let groups: Vec<Option<u64>> =
+            if m == Method::MbvhRs { a.rs_groups.iter().map(|&g| Some(g)).collect() } else { vec![None] };
+        groups.into_iter().map(move |g| (m, g))
+    });
+    let mut reports = Vec::new();
+    for (method, group) in runs {
+        for &t in &a.threads {
+            let options = TraceOptions { method, stream_group: group.map(|g| g as usize), ..Default::default() };
+            let mut tracer = Tracer::new(tree, None, options);
+            if let Some(m) = &mbvh {
+                tracer = tracer.with_mbvh(m);
+            }
+            if let Some(d) = &dacrt {
+                tracer = tracer.with_dacrt(d);
+            }
+            let tile = match group {
+                _ if method.uses_dacrt() => DACRT_TILE,
+                Some(g) => tile_for_group(HARNESS_TILE, g as u32),
+                None => HARNESS_TILE,
+            };
+            let setup = || drop(Dacrt::new(scene));
+            let setup = method.uses_dacrt().then_some(&setup as &(dyn Fn() + Sync));
+            let runs = (t as usize, a.warmup as usize, a.reps as usize);
+            let (report, results) = measure(&tracer, workload, tile, runs, setup)?;
+            validate(reference, workload, &results, 256).map_err(|m| format!("validation failed ({method}): {m}"))?;
+            let label = match group {
+                Some(g) => format!("{method} ({g})"),
+                None => method.to_string(),
+            };
+            reports.push((label, report));
+        }
+    }
+    Ok((mbvh_builds, dacrt_setup, reports))
 }
