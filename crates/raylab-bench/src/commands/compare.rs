@@ -13,8 +13,8 @@ use raylab_core::kdtree::KdTree;
 use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
-use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::scene::Scene;
+use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, Workload, WorkloadBuilder};
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_group};
