@@ -99,6 +99,11 @@ impl EmbreeRun {
     }
 }
 
+/// A report's checksum column: the occluded count, or the hits and their distances' sum.
+fn check_of(r: &TraceReport) -> String {
+    if r.kind.is_occlusion() { format!("{} occluded", r.hits) } else { format!("{} hits, {:.1}", r.hits, r.sum_t) }
+}
+
 /// Runs the harness for the ray kinds `kinds` (its `--kinds`: `none` only builds) with `builds` builds per
 /// thread count.
 fn run_embree(
@@ -250,11 +255,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             }
             None => ("n/a".into(), "n/a".into()),
         };
-        let check = if r.kind.is_occlusion() {
-            format!("{} occluded", r.hits)
-        } else {
-            format!("{} hits, {:.1}", r.hits, r.sum_t)
-        };
+        let check = check_of(r);
         let _ = writeln!(
             md,
             "| {} | {} | {:.2} ({:.2}-{:.2}) | {} | {} | {} | {} | {:.1} | {:.1} |",
@@ -303,11 +304,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                 Some(e) => (e.kind.clone(), format!("{:.2}", e.median), format!("{:.2}x", r.mrays_median / e.median)),
                 None => ("n/a".into(), "n/a".into(), "n/a".into()),
             };
-            let check = if r.kind.is_occlusion() {
-                format!("{} occluded", r.hits)
-            } else {
-                format!("{} hits, {:.1}", r.hits, r.sum_t)
-            };
+            let check = check_of(r);
             let _ = writeln!(
                 md,
                 "| {} | {} | {} | {} | {:.2} ({:.2}-{:.2}) | {:.2} | {:.2} | {:.1}% | {} | {} | {} | {} |",
