@@ -358,3 +358,80 @@ fn dacrt_traces_and_animate_reports_every_update_strategy() {
     let o = bench(&["trace", "--method", "dacrt", "--dacrt-split", "middle"], dir.path());
     assert!(!o.status.success() && stderr(&o).contains("sah, median"), "{}", stderr(&o));
 }
+
+/// A stand-in for the Embree harness: logs the `--kinds` it is asked for and prints, in the real harness's
+/// format, fixed figures for them.
+const FAKE_HARNESS: &str = r###"#!/bin/sh
+kinds=all
+while [ $# -gt 0 ]; do
+  if [ "$1" = "--kinds" ]; then kinds="$2"; fi
+  shift
+done
+echo "$kinds" >> "$0.log"
+echo "build HIGH       1 thread(s): median 0.123 s (min 0.100, max 0.200, 1 builds)"
+echo "## 16x16  (256 primary rays, 200 hit, checksum sum_t 1.0, mean_t 0.1)"
+case "$kinds" in
+  primary) echo "CSV,16x16,primary_1,1,256,1.500,1.400,1.600,0.000,1"
+           echo "CSV,16x16,primary_8_4x2,1,256,3.000,2.900,3.100,0.000,1" ;;
+  shadow) echo "CSV,16x16,shadow_1,1,200,2.500,2.400,2.600,0.000,1"
+          echo "CSV,16x16,shadow_8_4x2,1,200,4.000,3.900,4.100,0.000,1" ;;
+  diffuse) echo "CSV,16x16,diffuse_1,1,200,0.750,0.700,0.800,0.000,1"
+           echo "CSV,16x16,diffuse_1M,1,200,0.800,0.700,0.900,0.000,1" ;;
+esac
+"###;
+
+#[cfg(unix)]
+#[test]
+fn compare_takes_turns_with_the_harness_and_reports_its_figures() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let harness = dir.path().join("embree_bench");
+    std::fs::write(&harness, FAKE_HARNESS).unwrap();
+    std::fs::set_permissions(&harness, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let o = bench(
+        &[
+            "compare",
+            "--embree",
+            harness.to_str().unwrap(),
+            "--scene",
+            "arena",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--threads",
+            "1",
+            "--reps",
+            "1",
+            "--builds",
+            "1",
+            "--methods",
+            "mft",
+            "--tiles",
+            "4",
+            "--incoherent",
+            "mbvh-rs",
+            "--rs-groups",
+            "16",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Builds first, then one turn per ray kind, in the order raylab measures them.
+    let log = std::fs::read_to_string(dir.path().join("embree_bench.log")).unwrap();
+    assert_eq!(log, "none\nprimary\nshadow\ndiffuse\n");
+    let md = String::from_utf8_lossy(&o.stdout);
+    let row = |start: &str| md.lines().find(|l| l.starts_with(start)).unwrap_or_else(|| panic!("no row {start}: {md}"));
+    assert!(row("| primary | 1 |").contains("| rtcIntersect1 | 1.50 (1.40-1.60) |"), "{md}");
+    assert!(row("| shadow | 1 |").contains("| rtcOccluded1 | 2.50 (2.40-2.60) |"), "{md}");
+    assert!(row("| diffuse | 1 |").contains("| rtcIntersect1 | 0.75 (0.70-0.80) |"), "{md}");
+    assert!(row("| median of 1 | 1 |").ends_with("| 0.123 |"), "{md}");
+    assert!(row("| primary | 1 | mft | 4 |").contains("| primary_8_4x2 | 3.00 |"), "{md}");
+    assert!(row("| shadow | 1 | mft | 4 |").contains("| shadow_8_4x2 | 4.00 |"), "{md}");
+    assert!(
+        row("| mbvh-rs (16) | 1 |").contains("| 0.75 |") && row("| mbvh-rs (16) | 1 |").contains("| 0.80 |"),
+        "{md}"
+    );
+    // Each invocation repeats the primary check; the table lists it once.
+    assert_eq!(md.matches("256 primary rays").count(), 1, "{md}");
+}
