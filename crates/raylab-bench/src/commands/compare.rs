@@ -375,10 +375,13 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// MBVH builds per thread count, DACRT's setup time and the incoherent methods' reports on the diffuse rays
-/// `workload`: the MBVH methods (MBVH RS paper, each RS group size) and DACRT (seed 003).
+/// What the incoherent runs give: the MBVH's median build time per thread count, DACRT's setup time, and each
+/// method's report, labelled with its RS group size where it has one.
 type Incoherent = (Vec<(u64, f64)>, Option<f64>, Vec<(String, TraceReport)>);
 
+/// Builds the MBVH (per thread count, `--builds` times) and DACRT's setup as the methods need, then measures
+/// and validates the incoherent methods on the diffuse rays `workload`: the MBVH methods (MBVH RS paper, each
+/// RS group size) and DACRT (seed 003).
 fn incoherent_runs(
     a: &CompareArgs,
     scene: &Scene,
