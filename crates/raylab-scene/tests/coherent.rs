@@ -168,3 +168,45 @@ fn rendered_frames_are_identical_for_every_method() {
         assert_eq!(diff, 0, "{method} tile {tile}: {diff} pixels differ from mono");
     }
 }
+
+/// Invalid rays (zero or infinite direction, NaN origin or interval) inside a tile leave their pixels empty for
+/// every coherent method, and the valid rays around them still get mono's answers.
+#[test]
+fn invalid_rays_in_a_tile_are_ignored() {
+    let scene = builtin::build("arena", Detail::Test).unwrap();
+    let cam = scene.default_view().unwrap().camera;
+    let light = scene.lights[0].position;
+    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let bf = BruteForce::new(&scene);
+    let (w, h) = (16, 16);
+    let mut rays = WorkloadBuilder::new(&scene, &cam, light, w as u32, h as u32, &tree).build(RayKind::Primary).rays;
+    let o = cam.eye;
+    let bad = [
+        Ray::new(o, Vec3::ZERO),
+        Ray::new(Vec3::NAN, Vec3::X),
+        Ray::new(o, Vec3::new(f32::INFINITY, 0.0, 0.0)),
+        Ray::segment(o, Vec3::NEG_Y, 0.0, f32::NAN),
+        Ray::segment(o, Vec3::NEG_Y, f32::NAN, 1.0),
+    ];
+    for (k, i) in (0..w * h).step_by(7).enumerate() {
+        rays[i] = Some(bad[k % bad.len()]);
+    }
+    let mono = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
+    let (want_hits, want_occ) = trace_image(&mono, &rays, w, h, 8, None);
+    for (k, i) in (0..w * h).step_by(7).enumerate() {
+        assert!(want_hits[i].is_none() && !want_occ[i], "mono traced bad ray {k}");
+    }
+    for method in METHODS {
+        for backend in Backend::available() {
+            for tile in [4, 8, 16] {
+                let tracer = Tracer::new(&tree, None, TraceOptions { method, backend, ..TraceOptions::default() });
+                let (hits, occ) = trace_image(&tracer, &rays, w, h, tile, None);
+                for i in 0..w * h {
+                    let r = rays[i].unwrap();
+                    assert!(same_hit(&bf, &r, hits[i], want_hits[i]), "{method} {backend:?} tile {tile} pixel {i}");
+                    assert_eq!(occ[i], want_occ[i], "{method} {backend:?} tile {tile} pixel {i} occlusion");
+                }
+            }
+        }
+    }
+}

@@ -307,20 +307,10 @@ impl Mbvh {
         tri_slots: Range<usize>,
         shadow: bool,
     ) -> u64 {
-        // Every ray in a stream is valid, so the lanes are filled straight from the slots; empty lanes hold
-        // a ray along +z, which `from_lanes` accepts.
-        let mut lanes = [[0.0f32; 4]; 8];
-        lanes[5] = [1.0; 4];
-        for (lane, &id) in group.iter().enumerate() {
-            let r = &slots[id as usize].ray;
-            let fields =
-                [r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z, r.tmin, hot[id as usize].best()];
-            for (field, v) in lanes.iter_mut().zip(fields) {
-                field[lane] = v;
-            }
-        }
-        let [ox, oy, oz, dx, dy, dz, tmin, tmax] = lanes.map(|l| V::from_slice(&l));
-        let p = RayPacket::<V>::from_lanes([ox, oy, oz], [dx, dy, dz], tmin, tmax, (1 << group.len()) - 1);
+        // Each lane straight from the slots (every stream ray is valid), limited by its closest hit so far.
+        let p = RayPacket::<V>::gather(|i| {
+            group.get(i).map(|&id| Ray { tmax: hot[id as usize].best(), ..slots[id as usize].ray })
+        });
         let mut tests = 0;
         if shadow {
             let mut open = p.valid;

@@ -52,20 +52,21 @@ impl<V: Vf32> RayPacket<V> {
     #[inline(always)]
     pub fn new(rays: &[Option<Ray>]) -> Self {
         assert!(rays.len() <= V::LANES && V::LANES <= MAX_LANES);
-        Self::gather(rays, |i| (i < rays.len()).then_some(i))
+        Self::gather(|i| rays.get(i).copied().flatten().filter(Ray::is_valid))
     }
 
-    /// Packs lane `i` from `rays[index(i)]`, straight from the caller's rays (no copy of them first); a lane
-    /// whose index is `None`, or whose ray is `None` or invalid (NaN, zero direction), stays empty: it holds a
-    /// ray along +z, as [`Self::from_lanes`] accepts.
+    /// Packs lane `i` from `ray(i)`, straight from the caller's rays (no array of them first), which must be
+    /// `None` or a ray with [`Ray::is_valid`] (callers whose rays are known valid skip the check); a `None`
+    /// lane stays empty: it holds a ray along +z, as [`Self::from_lanes`] accepts.
     #[inline(always)]
-    pub fn gather(rays: &[Option<Ray>], index: impl Fn(usize) -> Option<usize>) -> Self {
+    pub fn gather(ray: impl Fn(usize) -> Option<Ray>) -> Self {
         let mut f = [[0.0f32; MAX_LANES]; 8];
         f[5] = [1.0; MAX_LANES];
         f[7] = [f32::INFINITY; MAX_LANES];
         let mut valid = 0u32;
         for i in 0..V::LANES {
-            let Some(r) = index(i).and_then(|j| rays[j].as_ref()).filter(|r| r.is_valid()) else { continue };
+            let Some(r) = ray(i) else { continue };
+            debug_assert!(r.is_valid());
             valid |= 1 << i;
             let values = [r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z, r.tmin, r.tmax];
             for (field, v) in f.iter_mut().zip(values) {

@@ -45,9 +45,9 @@ impl<V: Vf32> PacketTile<V> {
         let mut origin_pixel = Vec::with_capacity(cols * rows);
         for by in 0..rows {
             for bx in 0..cols {
-                packets.push(RayPacket::gather(rays, |i| {
+                packets.push(RayPacket::gather(|i| {
                     let (x, y) = (pw * bx + i % pw, ph * by + i / pw);
-                    (x < width && y < height).then(|| y * width + x)
+                    if x < width && y < height { rays[y * width + x].filter(Ray::is_valid) } else { None }
                 }));
                 origin_pixel.push((pw * bx, ph * by));
             }
