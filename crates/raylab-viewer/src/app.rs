@@ -191,7 +191,7 @@ impl App {
         }
         let done = self.automation.as_ref().filter(|a| a.due(&self.lab, &frame));
         if let Some(a) = done {
-            let r = a.finish(&w.front, &self.lab, &frame);
+            let r = a.finish(&mut w.front, &self.lab, &frame);
             w.front.finish(&mut self.lab, frame);
             if let Err(e) = r {
                 self.fail(event_loop, e);

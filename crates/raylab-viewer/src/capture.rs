@@ -2,16 +2,17 @@
 //! to a buffer and read back (rows padded to wgpu's 256-byte copy alignment, BGRA swizzled to RGBA).
 
 use crate::compositor::Compositor;
+use crate::gpu::Gpu;
 
 /// Draws the window's contents offscreen at `size` and returns them as an RGBA image.
 pub fn capture(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    compositor: &Compositor,
+    gpu: &Gpu,
+    compositor: &mut Compositor,
     size: (u32, u32),
     jobs: &[egui::ClippedPrimitive],
     screen: &egui_wgpu::ScreenDescriptor,
 ) -> Result<image::RgbaImage, String> {
+    let (device, queue) = (&gpu.device, &gpu.queue);
     let (w, h) = (size.0.max(1), size.1.max(1));
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("screenshot"),
@@ -32,7 +33,7 @@ pub fn capture(
         mapped_at_creation: false,
     });
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("screenshot") });
-    compositor.draw(queue, &mut encoder, &view, (w, h), jobs, screen);
+    compositor.draw(gpu, &mut encoder, &view, (w, h), jobs, screen);
     encoder.copy_texture_to_buffer(
         wgpu::TexelCopyTextureInfo {
             texture: &texture,

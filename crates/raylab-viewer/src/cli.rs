@@ -11,7 +11,11 @@ use crate::settings::RenderMode;
 
 /// raylab: fly through a scene traced on the CPU, switch traversal methods live and read what they cost.
 #[derive(Parser, Debug)]
+///
+/// The viewer starts with MFT, the fastest method on the built-in views, where `raylab-bench` defaults to mono,
+/// the baseline the thesis measures every other method against.
 #[command(name = "raylab", version, about)]
+#[command(mut_arg("method", |a| a.default_value("mft")))]
 pub struct Cli {
     #[command(flatten)]
     pub scene: SceneArgs,
@@ -140,5 +144,20 @@ fn one_of(allowed: &'static [u64]) -> impl Fn(&str) -> Result<u64, String> + Clo
             let list: Vec<String> = allowed.iter().map(u64::to_string).collect();
             Err(format!("{v} is not one of {}", list.join(", ")))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+    use raylab_core::method::Method;
+
+    use super::Cli;
+
+    #[test]
+    fn the_viewer_starts_with_mft_and_takes_any_method() {
+        let parse = |args: &[&str]| Cli::try_parse_from(std::iter::once("raylab").chain(args.iter().copied()));
+        assert_eq!(parse(&[]).expect("no flags").method.method, Method::Mft);
+        assert_eq!(parse(&["--method", "mono"]).expect("--method mono").method.method, Method::Mono);
     }
 }

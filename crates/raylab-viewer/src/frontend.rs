@@ -108,7 +108,7 @@ impl Frontend {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ui") });
         let extra = self.compositor.prepare_egui(device, queue, &mut encoder, &frame.jobs, &frame.screen);
-        self.compositor.draw(queue, &mut encoder, target, size, &frame.jobs, &frame.screen);
+        self.compositor.draw(&self.gpu, &mut encoder, target, size, &frame.jobs, &frame.screen);
         queue.submit(extra.into_iter().chain([encoder.finish()]));
         frame.cpu_ms += t0.elapsed().as_secs_f64() * 1e3;
     }
@@ -127,9 +127,9 @@ impl Frontend {
     }
 
     /// Draws `frame` offscreen and writes it as PNG.
-    pub fn screenshot(&self, frame: &UiFrame, path: &std::path::Path) -> Result<(), String> {
+    pub fn screenshot(&mut self, frame: &UiFrame, path: &std::path::Path) -> Result<(), String> {
         let size = (frame.screen.size_in_pixels[0], frame.screen.size_in_pixels[1]);
-        let img = capture(&self.gpu.device, &self.gpu.queue, &self.compositor, size, &frame.jobs, &frame.screen)?;
+        let img = capture(&self.gpu, &mut self.compositor, size, &frame.jobs, &frame.screen)?;
         img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
     }
 }
@@ -166,6 +166,8 @@ struct StatsFile<'a> {
     /// In hybrid mode, the last frame's G-buffer and costs.
     hybrid: Option<HybridStats>,
     readouts: StatsReport,
+    /// Times egui's output was drawn (the UI layer); the other UI frames reused the previous drawing.
+    ui_layer_draws: u64,
 }
 
 /// The hybrid mode's part of the `--json-stats` file: the last frame, and medians over all frames.
@@ -189,7 +191,7 @@ impl Automation {
     }
 
     /// Writes the requested outputs from `frame`; the error names the file.
-    pub fn finish(&self, front: &Frontend, lab: &Lab, frame: &UiFrame) -> Result<(), String> {
+    pub fn finish(&self, front: &mut Frontend, lab: &Lab, frame: &UiFrame) -> Result<(), String> {
         if let Some(p) = &self.screenshot {
             front.screenshot(frame, p)?;
         }
@@ -221,6 +223,7 @@ impl Automation {
                     composite_ms: lab.hybrid_gpu_ms.map(|m| m.1),
                 }),
                 readouts: lab.readouts.report(),
+                ui_layer_draws: front.compositor.ui_draws,
             };
             let json = serde_json::to_string_pretty(&file).map_err(|e| e.to_string())?;
             std::fs::write(p, json).map_err(|e| format!("cannot write {}: {e}", p.display()))?;

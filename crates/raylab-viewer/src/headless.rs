@@ -54,7 +54,7 @@ pub fn run(
         let mut frame = front.build(&mut lab, raw, size, 1.0);
         front.draw(&mut frame, &view, size);
         if automation.due(&lab, &frame) {
-            let r = automation.finish(&front, &lab, &frame);
+            let r = automation.finish(&mut front, &lab, &frame);
             front.finish(&mut lab, frame);
             return r;
         }

@@ -62,7 +62,7 @@ impl CompositePass {
                 uniform(4, (MATERIALS * MATERIAL_BYTES) as u64),
             ],
         });
-        let pipeline = fullscreen_pipeline(device, "composite", &shader, &layout, FRAME_FORMAT);
+        let pipeline = fullscreen_pipeline(device, "composite", &shader, &layout, FRAME_FORMAT, None);
         let buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),

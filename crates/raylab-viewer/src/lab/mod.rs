@@ -371,7 +371,8 @@ impl Lab {
         if self.hybrid_pending && !self.hybrid_busy {
             return Some(HYBRID_POLL);
         }
-        self.messages.iter().map(|m| MESSAGE_TIME.saturating_sub(m.at.elapsed())).min()
+        let message = self.messages.iter().map(|m| MESSAGE_TIME.saturating_sub(m.at.elapsed())).min();
+        message.into_iter().chain(self.readouts.refresh_due()).min()
     }
 
     fn poll_loading(&mut self) {
@@ -462,6 +463,7 @@ impl Lab {
 
     /// Draws the panels and overlays into `ui` (the whole window).
     pub fn ui(&mut self, ui: &mut egui::Ui) {
+        self.readouts.refresh(self.latest.as_deref());
         self.panel_rect = None;
         let ppp = ui.ctx().pixels_per_point();
         let px = |r: egui::Rect| [r.min.x * ppp, r.min.y * ppp, r.max.x * ppp, r.max.y * ppp];
@@ -502,7 +504,7 @@ impl Lab {
             .anchor(egui::Align2::RIGHT_TOP, egui::vec2(-8.0, 8.0))
             .interactable(false)
             .show(&ctx, |ui| {
-                egui::Frame::popup(ui.style()).show(ui, |ui| self.readouts.corner(ui, self.latest.as_deref()));
+                egui::Frame::popup(ui.style()).show(ui, |ui| self.readouts.corner(ui));
             });
         rects.push(r.response.rect);
         if let Some(r) = &self.latest

@@ -2,7 +2,7 @@
 //! GPU-side costs, and time series of the last seconds; also the JSON report `--json-stats` writes.
 
 use std::collections::VecDeque;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use egui_plot::{Legend, Line, Plot, PlotPoints};
 use raylab_core::render::{FrameView, StageTimes, depth_grey, heat_color};
@@ -14,6 +14,11 @@ use crate::worker::Rendered;
 /// Seconds of history the plots show.
 const HISTORY_S: f64 = 20.0;
 
+/// How often the numbers and plots on screen change while frames keep coming: often enough to follow, rarely
+/// enough to read, and it bounds how often the UI has to be drawn again (see `Compositor::draw`, which reuses
+/// the drawn UI while it stays the same) instead of once per traced frame.
+pub const REFRESH: Duration = Duration::from_millis(500);
+
 /// One traced frame, as the plots remember it.
 #[derive(Clone, Copy, Debug)]
 struct Sample {
@@ -21,6 +26,20 @@ struct Sample {
     ms: f64,
     n: f64,
     i: f64,
+}
+
+/// What the screen shows: the readouts as of the last refresh.
+#[derive(Clone, Default)]
+struct Shown {
+    /// Counters, stage times and wall seconds of the latest traced frame.
+    last: Option<(TraversalStats, StageTimes, f64)>,
+    /// The corner's lines about the latest traced frame: wall seconds and what traced it.
+    corner: Option<(f64, String)>,
+    upload_ms: f64,
+    ui_ms: f64,
+    ui_fps: usize,
+    /// The newest plotted sample's time: the plots end there.
+    until_t: f64,
 }
 
 /// Running readouts.
@@ -40,6 +59,11 @@ pub struct Readouts {
     hybrid_cpu: Vec<([f64; 3], Instant)>,
     /// Hybrid mode, per frame shown: upload and composite ms.
     hybrid_gpu: Vec<[f64; 2]>,
+    shown: Shown,
+    /// When `shown` was last refreshed.
+    shown_at: Option<Instant>,
+    /// A traced frame arrived since.
+    pending: bool,
 }
 
 /// The hybrid mode's medians over the frames so far (`--json-stats`).
@@ -67,6 +91,9 @@ impl Default for Readouts {
             ui_frames: VecDeque::new(),
             hybrid_cpu: Vec::new(),
             hybrid_gpu: Vec::new(),
+            shown: Shown::default(),
+            shown_at: None,
+            pending: false,
         }
     }
 }
@@ -80,8 +107,15 @@ fn culled_pct(s: &TraversalStats) -> f64 {
 impl Readouts {
     /// Adds a traced frame.
     pub fn push(&mut self, r: &Rendered) {
-        let s = r.frame.stats;
-        let ms = r.wall_s * 1e3;
+        self.push_frame(r.frame.stats, r.frame.stages, r.wall_s);
+        if let Some(h) = &r.hybrid {
+            self.hybrid_cpu.push(([h.raster_ms, h.readback_ms, h.trace_ms], Instant::now()));
+        }
+    }
+
+    /// Adds a traced frame's counters, stage times and wall seconds.
+    fn push_frame(&mut self, s: TraversalStats, stages: StageTimes, wall_s: f64) {
+        let ms = wall_s * 1e3;
         self.history.push_back(Sample {
             t: self.started.elapsed().as_secs_f64(),
             ms,
@@ -94,10 +128,48 @@ impl Readouts {
         }
         self.frame_ms.push(ms);
         self.totals += s;
-        self.stages += r.frame.stages;
-        self.last = Some((s, r.frame.stages, r.wall_s));
-        if let Some(h) = &r.hybrid {
-            self.hybrid_cpu.push(([h.raster_ms, h.readback_ms, h.trace_ms], Instant::now()));
+        self.stages += stages;
+        self.last = Some((s, stages, wall_s));
+        self.pending = true;
+    }
+
+    /// Brings what the screen shows up to date with `latest` (the newest traced frame) and the UI costs, at
+    /// most once per [`REFRESH`]; the first frame shows at once.
+    pub fn refresh(&mut self, latest: Option<&Rendered>) {
+        if !self.refresh_wait().is_zero() {
+            return;
+        }
+        let corner = latest.map(|r| {
+            let (w, h) = (r.frame.width, r.frame.height);
+            let what = if r.hybrid.is_some() {
+                format!("hybrid, {} reflections  {w}x{h} px", r.settings.hybrid.method)
+            } else {
+                format!("{} {}x{}  {w}x{h} px", r.settings.trace.method, r.settings.tile, r.settings.tile)
+            };
+            (r.wall_s, what)
+        });
+        self.shown = Shown {
+            last: self.last,
+            corner,
+            upload_ms: self.upload_ms.last().copied().unwrap_or(0.0),
+            ui_ms: self.ui_ms.last().copied().unwrap_or(0.0),
+            ui_fps: self.ui_fps(),
+            until_t: self.history.back().map_or(0.0, |s| s.t),
+        };
+        self.shown_at = Some(Instant::now());
+        self.pending = false;
+    }
+
+    /// How long until a refresh would show a traced frame the screen does not show yet, if one arrived.
+    pub fn refresh_due(&self) -> Option<Duration> {
+        self.pending.then(|| self.refresh_wait())
+    }
+
+    /// How long until the next refresh may change the screen: none while it shows no traced frame yet.
+    fn refresh_wait(&self) -> Duration {
+        match self.shown_at {
+            Some(t) if self.shown.last.is_some() => REFRESH.saturating_sub(t.elapsed()),
+            _ => Duration::ZERO,
         }
     }
 
@@ -151,31 +223,23 @@ impl Readouts {
     }
 
     /// The top-right corner: FPS and frame time (in hybrid mode, of the CPU part: raster, readback, trace).
-    pub fn corner(&self, ui: &mut egui::Ui, latest: Option<&Rendered>) {
-        match latest {
-            Some(r) => {
-                let ms = r.wall_s * 1e3;
+    pub fn corner(&self, ui: &mut egui::Ui) {
+        match &self.shown.corner {
+            Some((wall_s, what)) => {
+                let ms = wall_s * 1e3;
                 ui.monospace(format!("{:6.1} FPS  {:7.2} ms", 1e3 / ms.max(1e-6), ms));
-                let (w, h) = (r.frame.width, r.frame.height);
-                if r.hybrid.is_some() {
-                    ui.monospace(format!("hybrid, {} reflections  {w}x{h} px", r.settings.hybrid.method));
-                } else {
-                    ui.monospace(format!(
-                        "{} {}x{}  {w}x{h} px",
-                        r.settings.trace.method, r.settings.tile, r.settings.tile
-                    ));
-                }
+                ui.monospace(what);
             }
             None => {
                 ui.monospace("tracing the first frame...");
             }
         }
-        ui.monospace(format!("UI redraws {:3}/s", self.ui_fps()));
+        ui.monospace(format!("UI redraws {:3}/s", self.shown.ui_fps));
     }
 
     /// The readouts section of the panel.
     pub fn panel(&self, ui: &mut egui::Ui) {
-        let Some((s, st, wall)) = self.last else {
+        let Some((s, st, wall)) = self.shown.last else {
             ui.label("no frame yet");
             return;
         };
@@ -199,13 +263,13 @@ impl Readouts {
             for ((name, ms), p) in StageTimes::NAMES.iter().zip(st.as_array()).zip(pct) {
                 row(name, format!("{:.2} ms ({p:.0} %)", ms * 1e3));
             }
-            row("upload", format!("{:.3} ms", self.upload_ms.last().copied().unwrap_or(0.0)));
-            row("UI", format!("{:.3} ms", self.ui_ms.last().copied().unwrap_or(0.0)));
+            row("upload", format!("{:.3} ms", self.shown.upload_ms));
+            row("UI", format!("{:.3} ms", self.shown.ui_ms));
         });
         ui.small("stage times are summed over the tracer threads");
-        let t0 = self.history.back().map_or(0.0, |s| s.t);
+        let t0 = self.shown.until_t;
         let series = |f: fn(&Sample) -> f64| -> PlotPoints<'static> {
-            self.history.iter().map(|s| [s.t - t0, f(s)]).collect::<Vec<_>>().into()
+            self.history.iter().filter(|s| s.t <= t0).map(|s| [s.t - t0, f(s)]).collect::<Vec<_>>().into()
         };
         Plot::new("frame ms").height(90.0).legend(Legend::default()).allow_scroll(false).show(ui, |p| {
             p.line(Line::new("frame ms", series(|s| s.ms)));
@@ -301,4 +365,42 @@ pub fn legend(ui: &mut egui::Ui, view: FrameView, (lo, hi): (f32, f32)) {
         ui.add_space(110.0);
         ui.monospace(format!("{hi:.1}"));
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(rays: u64) -> TraversalStats {
+        TraversalStats { rays, ..TraversalStats::default() }
+    }
+
+    #[test]
+    fn the_screen_shows_new_figures_at_most_once_per_refresh() {
+        let mut r = Readouts::default();
+        assert_eq!(r.refresh_due(), None, "nothing traced, nothing to show");
+        r.push_frame(frame(10), StageTimes::default(), 0.1);
+        assert_eq!(r.refresh_due(), Some(Duration::ZERO), "the first frame shows at once");
+        r.push_ui(Some(0.5), 2.0);
+        r.refresh(None);
+        assert_eq!(r.shown.last.map(|l| l.0.rays), Some(10));
+        assert_eq!((r.shown.upload_ms, r.shown.ui_ms), (0.5, 2.0));
+        assert_eq!(r.refresh_due(), None);
+
+        r.push_frame(frame(20), StageTimes::default(), 0.1);
+        r.push_ui(None, 3.0);
+        let due = r.refresh_due().expect("a frame waits to be shown");
+        assert!(due > Duration::ZERO && due <= REFRESH, "{due:?}");
+        r.refresh(None);
+        assert_eq!(r.shown.last.map(|l| l.0.rays), Some(10), "too soon: the screen keeps the old figures");
+        assert_eq!(r.shown.ui_ms, 2.0);
+
+        std::thread::sleep(REFRESH);
+        assert_eq!(r.refresh_due(), Some(Duration::ZERO));
+        r.refresh(None);
+        assert_eq!(r.shown.last.map(|l| l.0.rays), Some(20));
+        assert_eq!(r.shown.ui_ms, 3.0);
+        assert_eq!(r.refresh_due(), None);
+        assert_eq!(r.report().frames, 2, "the report counts every frame, shown or not");
+    }
 }
