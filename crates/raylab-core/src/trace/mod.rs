@@ -9,6 +9,8 @@ mod proxy;
 
 pub use proxy::Proxy;
 
+use std::ops::Range;
+
 use glam::Vec3;
 use raylab_simd::{Backend, Kernel, VMask, Vf32};
 use serde::Serialize;
@@ -390,14 +392,17 @@ impl<'a> Tracer<'a> {
         let mut leftover: Option<Vec<usize>> = None;
         match self.options.method {
             Method::Frustum => {
-                match common_origin_frustum(&tile, &all).or_else(|| toward.and_then(|t| toward_frustum(rays, t, limit)))
+                let whole = RayRect { rays, width, x: 0..width, y: 0..height };
+                match common_origin_frustum(&tile, &all)
+                    .or_else(|| toward.and_then(|t| toward_frustum(whole, t, limit)))
                 {
                     Some(f) => self.tree.occluded_frustum(&f, &tile, &all, self.options.cull, &mut blocked, stats),
                     None => leftover = Some(all.clone()),
                 }
             }
             Method::Cone => {
-                match common_origin_cone(&tile, &all).or_else(|| toward.and_then(|t| toward_cone(rays, t, limit))) {
+                let whole = RayRect { rays, width, x: 0..width, y: 0..height };
+                match common_origin_cone(&tile, &all).or_else(|| toward.and_then(|t| toward_cone(whole, t, limit))) {
                     Some(c) => self.tree.occluded_frustum(&c, &tile, &all, self.options.cull, &mut blocked, stats),
                     None => leftover = Some(all.clone()),
                 }
@@ -440,7 +445,7 @@ impl<'a> Tracer<'a> {
         rays: &[Option<Ray>],
         toward: Option<Vec3>,
         common: fn(&PacketTile<V>, &[usize]) -> Option<B>,
-        toward_fn: fn(&[Option<Ray>], Vec3, f32) -> Option<B>,
+        toward_fn: fn(RayRect, Vec3, f32) -> Option<B>,
     ) -> Option<Quadrants<B>> {
         let (pw, ph) = (PacketTile::<V>::PACKET_W, PacketTile::<V>::PACKET_H);
         let (cx, cy) = (tile.cols.div_ceil(2) * pw, tile.rows.div_ceil(2) * ph);
@@ -462,9 +467,8 @@ impl<'a> Tracer<'a> {
                 Some(o) => (common(tile, &set)?, o),
                 None => {
                     let t = toward?;
-                    let sub: Vec<Option<Ray>> =
-                        (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| rays[y * w + x]).collect();
-                    match toward_fn(&sub, t, self.options.shadow_spread_limit) {
+                    let rect = RayRect { rays, width: w, x: x0..x1, y: y0..y1 };
+                    match toward_fn(rect, t, self.options.shadow_spread_limit) {
                         Some(b) => (b, t),
                         None => {
                             // Too wide (or not ending at the light): its packets go the packet way.
@@ -571,7 +575,7 @@ fn common_origin_cone<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Co
 
 /// The cone, seen from `toward`, of segments that end there (shadow rays to a light), like
 /// [`toward_frustum`].
-fn toward_cone(rays: &[Option<Ray>], toward: Vec3, spread_limit: f32) -> Option<Cone> {
+fn toward_cone(rays: RayRect, toward: Vec3, spread_limit: f32) -> Option<Cone> {
     let (segs, slack) = toward_segments(rays, toward, spread_limit)?;
     let mut c = Cone::bounding(toward, segs.iter().copied())?;
     let scale = toward.abs().max_element() + c.t_max;
@@ -590,16 +594,37 @@ fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option
 /// to trace as packets.
 type Quadrants<B> = ([Option<B>; 4], [Vec<usize>; 4], Vec<usize>);
 
+/// The rays of the pixel rectangle `x` by `y` of a row-major tile `width` pixels wide.
+#[derive(Clone)]
+struct RayRect<'a> {
+    rays: &'a [Option<Ray>],
+    width: usize,
+    x: Range<usize>,
+    y: Range<usize>,
+}
+
+impl<'a> RayRect<'a> {
+    /// The valid rays of the rectangle, row by row.
+    fn iter(&self) -> impl Iterator<Item = &'a Ray> + use<'a> {
+        let (rays, width, x) = (self.rays, self.width, self.x.clone());
+        self.y
+            .clone()
+            .flat_map(move |y| rays[y * width + x.start..y * width + x.end].iter())
+            .flatten()
+            .filter(|r| r.is_valid())
+    }
+}
+
 /// A segment seen from a light: unit direction, start and end distance.
 type Segment = (Vec3, f32, f32);
 
 /// The segments of `rays` seen from `toward`, and how far their ends miss it; `None` when some segment does
 /// not end near it, or when the bundle spreads wider than `spread_limit` (see
 /// [`TraceOptions::shadow_spread_limit`]).
-fn toward_segments(rays: &[Option<Ray>], toward: Vec3, spread_limit: f32) -> Option<(Vec<Segment>, f32)> {
+fn toward_segments(rays: RayRect, toward: Vec3, spread_limit: f32) -> Option<(Vec<Segment>, f32)> {
     let mut slack = 0.0f32;
-    let mut segs = Vec::new();
-    for r in rays.iter().flatten().filter(|r| r.is_valid()) {
+    let mut segs = Vec::with_capacity(rays.x.len() * rays.y.len());
+    for r in rays.iter() {
         if !r.tmax.is_finite() {
             return None;
         }
@@ -624,7 +649,7 @@ fn toward_segments(rays: &[Option<Ray>], toward: Vec3, spread_limit: f32) -> Opt
 
 /// The frustum, seen from `toward`, of segments that end there (shadow rays to a light): the thesis traces
 /// shadow rays from the light toward the surface points. `None` when some segment does not end near it.
-fn toward_frustum(rays: &[Option<Ray>], toward: Vec3, spread_limit: f32) -> Option<Frustum> {
+fn toward_frustum(rays: RayRect, toward: Vec3, spread_limit: f32) -> Option<Frustum> {
     let (segs, slack) = toward_segments(rays, toward, spread_limit)?;
     let mut f = Frustum::bounding(toward, segs)?;
     // Cover the rounding of the segments' ends and of the positions themselves.
