@@ -80,6 +80,8 @@ pub trait Vf32:
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
     /// Lane-wise absolute value.
     fn abs(self) -> Self;
+    /// Lane-wise square root, correctly rounded as `f32::sqrt` (NaN below zero).
+    fn sqrt(self) -> Self;
     /// The four columns of `LANES` four-float rows (`rows[i]` in lane `i`): loads records of four fields
     /// into one vector per field with a register transpose instead of a load per lane and field. `rows` must
     /// hold at least `LANES` rows.
@@ -234,6 +236,10 @@ mod tests {
             let sel = V::select(V::Mask::from_bits(rep(0b0101)), a, b);
             assert_eq!([sel.lane(0), sel.lane(1), sel.lane(n - 3)], [1.0, 3.0, 3.0]);
             assert_eq!(a.abs().lane(n - 3), 2.0);
+            let r = V::from_slice(&[2.0, 0.25, -1.0, -0.0, 3.0, 1e30, 7.0, 0.5][..n]).sqrt();
+            for (i, x) in [2.0f32, 0.25, -1.0, -0.0, 3.0, 1e30, 7.0, 0.5][..n].iter().enumerate() {
+                assert_eq!(r.lane(i).to_bits(), x.sqrt().to_bits(), "sqrt of {x}");
+            }
             assert_eq!(a.reduce_min(), -2.0);
             assert_eq!(a.reduce_max(), 1.0);
             let mut out = [0.0; 8];

@@ -128,6 +128,10 @@ impl Vf32 for F32x4 {
         Self(self.0.map(f32::abs))
     }
     #[inline(always)]
+    fn sqrt(self) -> Self {
+        Self(self.0.map(f32::sqrt))
+    }
+    #[inline(always)]
     fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
         std::array::from_fn(|c| Self(std::array::from_fn(|i| rows[i][c])))
     }

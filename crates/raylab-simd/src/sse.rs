@@ -141,6 +141,10 @@ impl Vf32 for F32x4 {
         Self(sse!(_mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff)))))
     }
     #[inline(always)]
+    fn sqrt(self) -> Self {
+        Self(sse!(_mm_sqrt_ps(self.0)))
+    }
+    #[inline(always)]
     fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
         // SAFETY: each row is a reference to four readable `f32`s and `loadu` has no alignment requirement.
         let load = |i: usize| unsafe { _mm_loadu_ps(rows[i].as_ptr()) };

@@ -157,6 +157,10 @@ impl Vf32 for F32x8 {
         Self(avx!(_mm256_and_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff)))))
     }
     #[inline(always)]
+    fn sqrt(self) -> Self {
+        Self(avx!(_mm256_sqrt_ps(self.0)))
+    }
+    #[inline(always)]
     fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
         assert!(rows.len() >= 8);
         // Rows i and i + 4 share a register (low and high half); the 4x4 transpose then runs in both halves.

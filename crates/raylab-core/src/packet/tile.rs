@@ -229,16 +229,23 @@ impl Frustum {
         if !any {
             return None;
         }
+        f.close_sides(any_pos, any_neg);
+        Some(f)
+    }
+
+    /// Finishes a frustum whose factors hold the extreme inverses of its rays, `any_pos[k]` and `any_neg[k]`
+    /// telling whether some ray goes each way on axis `k`: a far factor becomes infinite where some ray goes
+    /// the other way (or none goes this way), and `t_min` starts at zero at the earliest.
+    pub(crate) fn close_sides(&mut self, any_pos: [bool; 3], any_neg: [bool; 3]) {
         for k in 0..3 {
             if any_neg[k] || !any_pos[k] {
-                f.pos_far[k] = f32::INFINITY;
+                self.pos_far[k] = f32::INFINITY;
             }
             if any_pos[k] || !any_neg[k] {
-                f.neg_far[k] = f32::NEG_INFINITY;
+                self.neg_far[k] = f32::NEG_INFINITY;
             }
         }
-        f.t_min = f.t_min.max(0.0);
-        Some(f)
+        self.t_min = self.t_min.max(0.0);
     }
 
     /// The square pyramid from `apex` around `disc` (the face of a spherical light turned toward a shaded

@@ -21,7 +21,7 @@ use crate::kdtree::mft::Frustum4;
 use crate::mbvh::Mbvh;
 use crate::method::Method;
 use crate::packet::{Cone, Cone4};
-use crate::packet::{Frustum, PacketTile};
+use crate::packet::{Frustum, PacketTile, RayPacket, map3};
 use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
 use crate::render::RayOrder;
@@ -392,17 +392,19 @@ impl<'a> Tracer<'a> {
         let mut leftover: Option<Vec<usize>> = None;
         match self.options.method {
             Method::Frustum => {
-                let whole = RayRect { rays, width, x: 0..width, y: 0..height };
+                let whole =
+                    Bundled { tile: &tile, set: &all, rays: RayRect { rays, width, x: 0..width, y: 0..height } };
                 match common_origin_frustum(&tile, &all)
-                    .or_else(|| toward.and_then(|t| toward_frustum(whole, t, limit)))
+                    .or_else(|| toward.and_then(|t| toward_frustum(&whole, t, limit)))
                 {
                     Some(f) => self.tree.occluded_frustum(&f, &tile, &all, self.options.cull, &mut blocked, stats),
                     None => leftover = Some(all.clone()),
                 }
             }
             Method::Cone => {
-                let whole = RayRect { rays, width, x: 0..width, y: 0..height };
-                match common_origin_cone(&tile, &all).or_else(|| toward.and_then(|t| toward_cone(whole, t, limit))) {
+                let whole =
+                    Bundled { tile: &tile, set: &all, rays: RayRect { rays, width, x: 0..width, y: 0..height } };
+                match common_origin_cone(&tile, &all).or_else(|| toward.and_then(|t| toward_cone(&whole, t, limit))) {
                     Some(c) => self.tree.occluded_frustum(&c, &tile, &all, self.options.cull, &mut blocked, stats),
                     None => leftover = Some(all.clone()),
                 }
@@ -445,7 +447,7 @@ impl<'a> Tracer<'a> {
         rays: &[Option<Ray>],
         toward: Option<Vec3>,
         common: fn(&PacketTile<V>, &[usize]) -> Option<B>,
-        toward_fn: fn(RayRect, Vec3, f32) -> Option<B>,
+        toward_fn: fn(&Bundled<V>, Vec3, f32) -> Option<B>,
     ) -> Option<Quadrants<B>> {
         let (pw, ph) = (PacketTile::<V>::PACKET_W, PacketTile::<V>::PACKET_H);
         let (cx, cy) = (tile.cols.div_ceil(2) * pw, tile.rows.div_ceil(2) * ph);
@@ -467,8 +469,8 @@ impl<'a> Tracer<'a> {
                 Some(o) => (common(tile, &set)?, o),
                 None => {
                     let t = toward?;
-                    let rect = RayRect { rays, width: w, x: x0..x1, y: y0..y1 };
-                    match toward_fn(rect, t, self.options.shadow_spread_limit) {
+                    let rays = RayRect { rays, width: w, x: x0..x1, y: y0..y1 };
+                    match toward_fn(&Bundled { tile, set: &set, rays }, t, self.options.shadow_spread_limit) {
                         Some(b) => (b, t),
                         None => {
                             // Too wide (or not ending at the light): its packets go the packet way.
@@ -573,10 +575,10 @@ fn common_origin_cone<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Co
     Cone::from_packets(common_origin(tile, set)?, &tile.packets, set)
 }
 
-/// The cone, seen from `toward`, of segments that end there (shadow rays to a light), like
-/// [`toward_frustum`].
-fn toward_cone(rays: RayRect, toward: Vec3, spread_limit: f32) -> Option<Cone> {
-    let (segs, slack) = toward_segments(rays, toward, spread_limit)?;
+/// The cone, seen from `toward`, of the rays of `b` when they are segments that end there (shadow rays to a
+/// light), like [`toward_frustum`].
+fn toward_cone<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f32) -> Option<Cone> {
+    let (segs, slack) = toward_segments(b.rays.clone(), toward, spread_limit)?;
     let mut c = Cone::bounding(toward, segs.iter().copied())?;
     let scale = toward.abs().max_element() + c.t_max;
     c.origin_slack = slack * 2.0 + scale * 4.0 * f32::EPSILON;
@@ -593,6 +595,13 @@ fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option
 /// A tile's four quadrant bundles (empty quadrants are `None`), the packets each bounds, and the packets left
 /// to trace as packets.
 type Quadrants<B> = ([Option<B>; 4], [Vec<usize>; 4], Vec<usize>);
+
+/// The rays a bundle is to bound: packets `set` of `tile`, which hold the valid rays of `rays`.
+struct Bundled<'a, V: Vf32> {
+    tile: &'a PacketTile<V>,
+    set: &'a [usize],
+    rays: RayRect<'a>,
+}
 
 /// The rays of the pixel rectangle `x` by `y` of a row-major tile `width` pixels wide.
 #[derive(Clone)]
@@ -647,14 +656,188 @@ fn toward_segments(rays: RayRect, toward: Vec3, spread_limit: f32) -> Option<(Ve
     (spread <= spread_limit).then_some((segs, slack))
 }
 
-/// The frustum, seen from `toward`, of segments that end there (shadow rays to a light): the thesis traces
-/// shadow rays from the light toward the surface points. `None` when some segment does not end near it.
-fn toward_frustum(rays: RayRect, toward: Vec3, spread_limit: f32) -> Option<Frustum> {
-    let (segs, slack) = toward_segments(rays, toward, spread_limit)?;
-    let mut f = Frustum::bounding(toward, segs)?;
-    // Cover the rounding of the segments' ends and of the positions themselves.
+/// The frustum, seen from `toward`, of the rays of `b` (its packets) when they are segments that end
+/// there (shadow rays to a light: the thesis traces shadow rays from the light toward the surface points);
+/// `None` when some segment does not end near it or the bundle spreads wider than `spread_limit`. A vector
+/// of segments at a time, per lane with the operations of [`toward_segments`] and [`Frustum::bounding`] in
+/// their order, so the frustum and its slack are theirs to the bit; only the mean direction of the spread
+/// test is summed in another order, which can move a bundle right at the spread limit to the packet side.
+#[inline(always)]
+fn toward_frustum<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f32) -> Option<Frustum> {
+    let (tile, set) = (b.tile, b.set);
+    let (zero, inf, ninf) = (V::splat(0.0), V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
+    let tw = [V::splat(toward.x), V::splat(toward.y), V::splat(toward.z)];
+    let (mut gap_max, mut t_max) = (zero, ninf);
+    let (mut pos_near, mut pos_far, mut neg_near, mut neg_far) = ([inf; 3], [ninf; 3], [ninf; 3], [inf; 3]);
+    let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
+    let mut sum = [zero; 3];
+    for p in set.iter().map(|&j| &tile.packets[j]).filter(|p| p.valid.any()) {
+        let valid = p.valid;
+        let (d, len, gap) = toward_segment(p, &tw);
+        let far_end = !p.tmax.abs().lt(inf);
+        let misses = gap.gt(V::splat(TOWARD_TOLERANCE) * len.max(V::splat(f32::MIN_POSITIVE))) | len.eq(zero);
+        if ((far_end | misses) & valid).any() {
+            return None;
+        }
+        gap_max = gap_max.max(V::select(valid, gap, zero));
+        t_max = t_max.max(V::select(valid, len, ninf));
+        for k in 0..3 {
+            let inv = V::splat(1.0) / d[k];
+            let pos = inv.gt(zero) & valid;
+            let neg = valid & !pos;
+            any_pos[k] |= pos.any();
+            any_neg[k] |= neg.any();
+            pos_near[k] = pos_near[k].min(V::select(pos, inv, inf));
+            pos_far[k] = pos_far[k].max(V::select(pos, inv, ninf));
+            neg_near[k] = neg_near[k].max(V::select(neg, inv, ninf));
+            neg_far[k] = neg_far[k].min(V::select(neg, inv, inf));
+            sum[k] = sum[k] + V::select(valid, d[k], zero);
+        }
+    }
+    if !(0..3).any(|k| any_pos[k] || any_neg[k]) {
+        return None;
+    }
+    let mut mean = [0.0f32; 3];
+    for k in 0..3 {
+        for i in 0..V::LANES {
+            mean[k] += sum[k].lane(i);
+        }
+    }
+    let mean = Vec3::from_array(mean).normalize_or_zero();
+    let m = [V::splat(mean.x), V::splat(mean.y), V::splat(mean.z)];
+    let mut spread = zero;
+    for p in set.iter().map(|&j| &tile.packets[j]).filter(|p| p.valid.any()) {
+        let (d, _, _) = toward_segment(p, &tw);
+        let c = dot3(&d, &m);
+        let cross = [d[1] * m[2] - m[1] * d[2], d[2] * m[0] - m[2] * d[0], d[0] * m[1] - m[0] * d[1]];
+        let tangent = V::select(c.gt(zero), dot3(&cross, &cross).sqrt() / c, inf);
+        spread = spread.max(V::select(p.valid, tangent, zero));
+    }
+    if spread.reduce_max() > spread_limit {
+        return None;
+    }
+    let mut f = Frustum {
+        origin: toward,
+        pos_near: [0.0; 3],
+        pos_far: [0.0; 3],
+        neg_near: [0.0; 3],
+        neg_far: [0.0; 3],
+        t_min: 0.0,
+        t_max: t_max.reduce_max(),
+        origin_slack: 0.0,
+    };
+    for k in 0..3 {
+        f.pos_near[k] = pos_near[k].reduce_min();
+        f.pos_far[k] = pos_far[k].reduce_max();
+        f.neg_near[k] = neg_near[k].reduce_max();
+        f.neg_far[k] = neg_far[k].reduce_min();
+    }
+    f.close_sides(any_pos, any_neg);
+    widen_toward(&mut f, toward, gap_max.reduce_max());
+    Some(f)
+}
+
+/// `a . b` per lane, summed in glam's order.
+#[inline(always)]
+fn dot3<V: Vf32>(a: &[V; 3], b: &[V; 3]) -> V {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Each lane's segment seen from `tw` (a point in every lane), with [`toward_segments`]' operations: unit
+/// direction, length, and how far the segment's end misses the point.
+#[inline(always)]
+fn toward_segment<V: Vf32>(p: &RayPacket<V>, tw: &[V; 3]) -> ([V; 3], V, V) {
+    let t0 = p.tmin.max(V::splat(0.0));
+    let v = map3([0, 1, 2], |k| p.org[k] + p.dir[k] * t0 - tw[k]);
+    let e = map3([0, 1, 2], |k| p.org[k] + p.dir[k] * p.tmax - tw[k]);
+    let len = dot3(&v, &v).sqrt();
+    (map3([0, 1, 2], |k| v[k] / len), len, dot3(&e, &e).sqrt())
+}
+
+/// Widens a frustum seen from `toward` to cover the rounding of its segments' ends (`slack`: how far the
+/// farthest misses `toward`) and of the positions themselves.
+fn widen_toward(f: &mut Frustum, toward: Vec3, slack: f32) {
     let scale = toward.abs().max_element() + f.t_max;
     f.origin_slack = slack * 2.0 + scale * 4.0 * f32::EPSILON;
     f.t_max = f.t_max * (1.0 + 4.0 * f32::EPSILON) + f.origin_slack;
-    Some(f)
+}
+
+#[cfg(test)]
+mod tests {
+    use raylab_simd::{Backend, Kernel, dispatch};
+
+    use super::*;
+
+    /// [`toward_frustum`] on one backend's packets, and the scalar segments of the same rays bounded by
+    /// [`Frustum::bounding`].
+    struct BothWays<'a> {
+        rays: &'a [Option<Ray>],
+        width: usize,
+        light: Vec3,
+        limit: f32,
+    }
+
+    impl Kernel for BothWays<'_> {
+        type Output = (Option<Frustum>, Option<Frustum>);
+        fn run<V: Vf32>(self) -> Self::Output {
+            let height = self.rays.len() / self.width;
+            let tile = PacketTile::<V>::new(self.rays, self.width, height);
+            let all: Vec<usize> = (0..tile.packets.len()).collect();
+            let rays = RayRect { rays: self.rays, width: self.width, x: 0..self.width, y: 0..height };
+            let packets =
+                toward_frustum(&Bundled { tile: &tile, set: &all, rays: rays.clone() }, self.light, self.limit);
+            let scalar = toward_segments(rays, self.light, self.limit).and_then(|(segs, slack)| {
+                let mut f = Frustum::bounding(self.light, segs)?;
+                widen_toward(&mut f, self.light, slack);
+                Some(f)
+            });
+            (packets, scalar)
+        }
+    }
+
+    /// Shadow rays from points around `center` (spread `spread`, on the plane y = 0) to `light`, in a 6x5 tile
+    /// (partial packets), with a hole and an invalid ray; the first point lies straight below the light when
+    /// `below` is set (zero x and z direction components).
+    fn shadow_rays(center: Vec3, spread: f32, light: Vec3, below: bool) -> Vec<Option<Ray>> {
+        let mut seed = 12345u32;
+        let mut next = move || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+        };
+        (0..30)
+            .map(|i| match i {
+                7 => None,
+                11 => Some(Ray::segment(Vec3::NAN, Vec3::Y, 0.0, 1.0)),
+                _ => {
+                    let p = if i == 0 && below {
+                        Vec3::new(light.x, 0.0, light.z)
+                    } else {
+                        center + Vec3::new(next() * spread, 0.0, next() * spread)
+                    };
+                    let to = light - p;
+                    Some(Ray::segment(p, to / to.length(), 1e-3, to.length()))
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn bundles_from_packets_equal_the_scalar_segments_on_every_backend() {
+        let light = Vec3::new(0.3, 11.0, -0.2);
+        let wide = shadow_rays(Vec3::ZERO, 30.0, light, true);
+        let narrow = shadow_rays(Vec3::new(40.0, 0.0, 35.0), 1.0, light, false);
+        let mut short = narrow.clone();
+        short[3] = short[3].map(|r| Ray { tmax: r.tmax * 0.5, ..r });
+        for backend in Backend::available() {
+            let both = |rays: &[Option<Ray>], limit: f32| dispatch(backend, BothWays { rays, width: 6, light, limit });
+            let (packets, scalar) = both(&wide, f32::INFINITY);
+            assert!(packets.is_some(), "{backend:?}: an unlimited spread takes every bundle");
+            assert_eq!(packets, scalar, "{backend:?}: mixed signs and a zero component");
+            let (packets, scalar) = both(&narrow, 0.05);
+            assert!(packets.is_some(), "{backend:?}: a narrow bundle");
+            assert_eq!(packets, scalar, "{backend:?}: narrow bundle");
+            assert_eq!(both(&wide, 0.05), (None, None), "{backend:?}: too wide for the limit");
+            assert_eq!(both(&short, f32::INFINITY), (None, None), "{backend:?}: a segment that stops short");
+        }
+    }
 }
