@@ -580,9 +580,7 @@ fn common_origin_cone<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Co
 fn toward_cone<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f32) -> Option<Cone> {
     let (segs, slack) = toward_segments(b.rays.clone(), toward, spread_limit)?;
     let mut c = Cone::bounding(toward, segs.iter().copied())?;
-    let scale = toward.abs().max_element() + c.t_max;
-    c.origin_slack = slack * 2.0 + scale * 4.0 * f32::EPSILON;
-    c.t_max = c.t_max * (1.0 + 4.0 * f32::EPSILON) + c.origin_slack;
+    widen_toward(&mut c.t_max, &mut c.origin_slack, toward, slack);
     Some(c)
 }
 
@@ -733,7 +731,7 @@ fn toward_frustum<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f32) -> O
         f.neg_far[k] = neg_far[k].reduce_min();
     }
     f.close_sides(any_pos, any_neg);
-    widen_toward(&mut f, toward, gap_max.reduce_max());
+    widen_toward(&mut f.t_max, &mut f.origin_slack, toward, gap_max.reduce_max());
     Some(f)
 }
 
@@ -754,12 +752,12 @@ fn toward_segment<V: Vf32>(p: &RayPacket<V>, tw: &[V; 3]) -> ([V; 3], V, V) {
     (map3([0, 1, 2], |k| v[k] / len), len, dot3(&e, &e).sqrt())
 }
 
-/// Widens a frustum seen from `toward` to cover the rounding of its segments' ends (`slack`: how far the
-/// farthest misses `toward`) and of the positions themselves.
-fn widen_toward(f: &mut Frustum, toward: Vec3, slack: f32) {
-    let scale = toward.abs().max_element() + f.t_max;
-    f.origin_slack = slack * 2.0 + scale * 4.0 * f32::EPSILON;
-    f.t_max = f.t_max * (1.0 + 4.0 * f32::EPSILON) + f.origin_slack;
+/// Widens a bundle seen from `toward` (its end distance and origin slack) to cover the rounding of its
+/// segments' ends (`slack`: how far the farthest misses `toward`) and of the positions themselves.
+fn widen_toward(t_max: &mut f32, origin_slack: &mut f32, toward: Vec3, slack: f32) {
+    let scale = toward.abs().max_element() + *t_max;
+    *origin_slack = slack * 2.0 + scale * 4.0 * f32::EPSILON;
+    *t_max = *t_max * (1.0 + 4.0 * f32::EPSILON) + *origin_slack;
 }
 
 #[cfg(test)]
@@ -788,7 +786,7 @@ mod tests {
                 toward_frustum(&Bundled { tile: &tile, set: &all, rays: rays.clone() }, self.light, self.limit);
             let scalar = toward_segments(rays, self.light, self.limit).and_then(|(segs, slack)| {
                 let mut f = Frustum::bounding(self.light, segs)?;
-                widen_toward(&mut f, self.light, slack);
+                widen_toward(&mut f.t_max, &mut f.origin_slack, self.light, slack);
                 Some(f)
             });
             (packets, scalar)
