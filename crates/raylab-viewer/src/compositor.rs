@@ -2,11 +2,11 @@
 //! full-target triangle (`shaders/frame.wgsl`), then the egui panels over it.
 //!
 //! egui's output is drawn into a texture of its own (the UI layer), which is laid over the frame where egui
-//! drew and drawn again only when the output changed. A redraw of the unchanged UI, the common case while
-//! frames stream in or the UI is asked to redraw often, then costs one full-target copy and a blend of the
-//! UI's pixels. It matters most on software Vulkan
-//! (lavapipe), where egui's fragment shader costs tens of milliseconds of CPU per draw of a 1280x720 window
-//! with the panel, time taken from the tracer on the same cores.
+//! drew; its meshes are uploaded and drawn again only when they changed. A redraw of the unchanged UI, the
+//! common case while frames stream in or the UI is asked to redraw often, then costs one full-target copy and
+//! a blend of the UI's pixels. It matters most on software Vulkan (lavapipe), where egui's fragment shader
+//! costs tens of milliseconds of CPU per draw of a 1280x720 window with the panel, time taken from the tracer
+//! on the same cores.
 
 use std::time::{Duration, Instant};
 
@@ -70,9 +70,7 @@ struct UiLayer {
     bind_group: wgpu::BindGroup,
     size: (u32, u32),
     pixels_per_point: f32,
-    /// The meshes drawn; empty until the first draw.
-    jobs: Vec<egui::ClippedPrimitive>,
-    /// The pixels they cover, as disjoint rectangles (see [`drawn_rects`]).
+    /// The pixels egui drew, as disjoint rectangles (see [`drawn_rects`]).
     rects: Vec<PixelRect>,
 }
 
@@ -136,8 +134,11 @@ pub struct Compositor {
     params: wgpu::Buffer,
     frame: Option<FrameTexture>,
     ui: Option<UiLayer>,
-    /// egui's textures changed since the UI layer was drawn.
-    ui_textures_changed: bool,
+    /// The meshes and screen (size in pixels, pixels per point) last handed to egui's renderer.
+    ui_jobs: Vec<egui::ClippedPrimitive>,
+    ui_screen: Option<([u32; 2], f32)>,
+    /// egui's output (meshes, screen or textures) changed since the UI layer was drawn.
+    ui_stale: bool,
     /// Times the UI layer was drawn.
     pub ui_draws: u64,
     /// egui's renderer.
@@ -200,7 +201,9 @@ impl Compositor {
             params,
             frame: None,
             ui: None,
-            ui_textures_changed: false,
+            ui_jobs: Vec::new(),
+            ui_screen: None,
+            ui_stale: false,
             ui_draws: 0,
             egui,
         }
@@ -282,10 +285,10 @@ impl Compositor {
         })
     }
 
-    /// Makes the UI layer when there is none of `size` pixels.
-    fn ensure_ui_layer(&mut self, device: &wgpu::Device, size: (u32, u32), pixels_per_point: f32) {
+    /// Makes the UI layer when there is none of `size` pixels; true when it made one.
+    fn ensure_ui_layer(&mut self, device: &wgpu::Device, size: (u32, u32), pixels_per_point: f32) -> bool {
         if self.ui.as_ref().is_some_and(|l| l.size == size && l.pixels_per_point == pixels_per_point) {
-            return;
+            return false;
         }
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("ui layer"),
@@ -299,7 +302,8 @@ impl Compositor {
         });
         let bind_group = self.bind_texture(device, "ui layer", &texture);
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        self.ui = Some(UiLayer { view, bind_group, size, pixels_per_point, jobs: Vec::new(), rects: Vec::new() });
+        self.ui = Some(UiLayer { view, bind_group, size, pixels_per_point, rects: Vec::new() });
+        true
     }
 
     /// Applies egui's texture changes of a UI frame: new and updated textures now, and returns the ones to
@@ -315,13 +319,14 @@ impl Compositor {
                 self.egui.update_texture(device, queue, *id, delta);
             }
         }
-        self.ui_textures_changed |= !textures.set.is_empty() || !textures.free.is_empty();
+        self.ui_stale |= !textures.set.is_empty() || !textures.free.is_empty();
         let free = std::mem::take(&mut textures.free).into_iter().collect();
         textures.clear();
         free
     }
 
-    /// Hands this frame's egui meshes to the GPU; returns command buffers to submit before the draw's.
+    /// Hands this frame's egui meshes to the GPU when they differ from the last ones (the UI layer is then
+    /// drawn again, see [`Compositor::draw`]); returns command buffers to submit before the draw's.
     pub fn prepare_egui(
         &mut self,
         device: &wgpu::Device,
@@ -330,6 +335,13 @@ impl Compositor {
         jobs: &[egui::ClippedPrimitive],
         screen: &egui_wgpu::ScreenDescriptor,
     ) -> Vec<wgpu::CommandBuffer> {
+        let key = (screen.size_in_pixels, screen.pixels_per_point);
+        if !self.ui_stale && self.ui_screen == Some(key) && same_jobs(&self.ui_jobs, jobs) {
+            return Vec::new();
+        }
+        self.ui_stale = true;
+        self.ui_screen = Some(key);
+        self.ui_jobs = jobs.to_vec();
         self.egui.update_buffers(device, queue, encoder, jobs, screen)
     }
 
@@ -340,8 +352,9 @@ impl Compositor {
         }
     }
 
-    /// Draws the latest frame and the UI into `target` (of `size` pixels and of this compositor's format). The
-    /// UI layer is drawn again first when egui's meshes, textures or the target's size changed.
+    /// Draws the latest frame and the UI into `target` (of `size` pixels and of this compositor's format), `jobs`
+    /// being the meshes last handed to [`Compositor::prepare_egui`]. The UI layer is drawn again first when
+    /// egui's output or the target's size changed.
     pub fn draw(
         &mut self,
         gpu: &Gpu,
@@ -357,13 +370,12 @@ impl Compositor {
         params[0..4].copy_from_slice(&(size.0 as f32).to_le_bytes());
         params[4..8].copy_from_slice(&(size.1 as f32).to_le_bytes());
         queue.write_buffer(&self.params, 0, &params);
-        self.ensure_ui_layer(device, size, screen.pixels_per_point);
-        if let Some(layer) = self.ui.as_mut().filter(|l| self.ui_textures_changed || !same_jobs(&l.jobs, jobs)) {
+        let made = self.ensure_ui_layer(device, size, screen.pixels_per_point);
+        if let Some(layer) = self.ui.as_mut().filter(|_| made || self.ui_stale) {
             let mut pass = target_pass(encoder, "ui layer", &layer.view, wgpu::Color::TRANSPARENT);
             self.egui.render(&mut pass, jobs, screen);
-            layer.jobs = jobs.to_vec();
             layer.rects = drawn_rects(jobs, screen.pixels_per_point, size);
-            self.ui_textures_changed = false;
+            self.ui_stale = false;
             self.ui_draws += 1;
         }
         let mut pass = target_pass(encoder, "window", target, wgpu::Color { r: 0.08, g: 0.08, b: 0.09, a: 1.0 });

@@ -17,7 +17,7 @@ const HISTORY_S: f64 = 20.0;
 /// How often the numbers and plots on screen change while frames keep coming: often enough to follow, rarely
 /// enough to read, and it bounds how often the UI has to be drawn again (see `Compositor::draw`, which reuses
 /// the drawn UI while it stays the same) instead of once per traced frame.
-pub const REFRESH: Duration = Duration::from_millis(500);
+const REFRESH: Duration = Duration::from_millis(500);
 
 /// One traced frame, as the plots remember it.
 #[derive(Clone, Copy, Debug)]
