@@ -38,30 +38,41 @@ const LEFT: u8 = 0;
 const RIGHT: u8 = 1;
 const BOTH: u8 = 2;
 
-/// A split-candidate event: a plane position on one axis and the triangle it belongs to.
-#[derive(Clone, Copy, Debug)]
-struct Event {
-    pos: f32,
-    /// `tri << 2 | kind`.
-    packed: u32,
+/// A split-candidate event: a plane position on one axis, its kind and the triangle it belongs to, packed
+/// into one integer that is also its sort key: `position << 32 | kind << 30 | triangle`, the position as
+/// [`ordered_bits`]. Events sort by position, then end < planar < start as the sweep expects (then by
+/// triangle, which only makes the order total), with plain integer compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Event(u64);
+
+/// The bits of a finite `f32` as an integer that orders like the float (-0.0 and +0.0 coincide).
+fn ordered_bits(x: f32) -> u32 {
+    // `+ 0.0` turns -0.0 into +0.0 so that equal positions sort together.
+    let b = (x + 0.0).to_bits();
+    if b >> 31 == 1 { !b } else { b | 0x8000_0000 }
 }
 
 impl Event {
+    /// A placeholder for slots about to be overwritten.
+    const BLANK: Self = Self(0);
+
     fn new(pos: f32, tri: u32, kind: u32) -> Self {
-        // `+ 0.0` turns -0.0 into +0.0 so that equal positions sort together.
-        Self { pos: pos + 0.0, packed: (tri << 2) | kind }
+        debug_assert!(tri < 1 << 30 && kind < 3);
+        Self((ordered_bits(pos) as u64) << 32 | (kind as u64) << 30 | tri as u64)
+    }
+    /// The position as [`ordered_bits`]: compares as the position does.
+    fn pos_key(self) -> u32 {
+        (self.0 >> 32) as u32
+    }
+    fn pos(self) -> f32 {
+        let o = self.pos_key();
+        f32::from_bits(if o >> 31 == 1 { o & 0x7fff_ffff } else { !o })
     }
     fn tri(self) -> usize {
-        (self.packed >> 2) as usize
+        (self.0 & ((1 << 30) - 1)) as usize
     }
     fn kind(self) -> u32 {
-        self.packed & 3
-    }
-    /// Sort key: position, then end < planar < start, as the sweep expects.
-    fn key(self) -> u64 {
-        let b = self.pos.to_bits();
-        let ordered = if b >> 31 == 1 { !b } else { b | 0x8000_0000 };
-        ((ordered as u64) << 2) | self.kind() as u64
+        (self.0 >> 30) as u32 & 3
     }
 }
 
@@ -92,10 +103,12 @@ impl Scratch {
         }
     }
 
-    fn take(&mut self, capacity: usize) -> Vec<Event> {
+    /// A vector of `len` events whose values are left over from earlier use (the caller overwrites them):
+    /// only the part beyond what the reused vector held is initialised. (The most recently freed vector is
+    /// taken even when an older one is long enough: it is still in the cache, which matters more.)
+    fn take(&mut self, len: usize) -> Vec<Event> {
         let mut v = self.free.pop().unwrap_or_default();
-        v.clear();
-        v.reserve(capacity);
+        v.resize(len, Event::BLANK);
         v
     }
 
@@ -138,10 +151,36 @@ pub(super) fn build(tris: &[[Vec3; 3]], bounds: Aabb, params: &KdParams) -> Buil
             push_events(list, a, i as u32, &b);
         }
     }
-    rayon::scope(|_| {
-        events.iter_mut().for_each(|l| l.sort_unstable_by_key(|e| e.key()));
-    });
+    events.iter_mut().for_each(sort_root_events);
     build_parallel(&ctx, Task { bounds, events, n: tris.len(), depth: 0 })
+}
+
+/// Sorts an event list built in triangle order, in three passes of a least-significant-digit radix sort
+/// over the position and kind bits (12-bit digits, the top two overlapping the ones below, which still
+/// orders by all 34 bits). The sort is stable, so events with equal position and kind stay in triangle
+/// order: the same order as sorting the whole integers.
+fn sort_root_events(v: &mut Vec<Event>) {
+    const DIGIT: u32 = 12;
+    let mut out = vec![Event::BLANK; v.len()];
+    let mut count = vec![0usize; 1 << DIGIT];
+    for shift in [30, 41, 52] {
+        let digit = |e: &Event| (e.0 >> shift) as usize & ((1 << DIGIT) - 1);
+        count.fill(0);
+        for e in v.iter() {
+            count[digit(e)] += 1;
+        }
+        let mut sum = 0;
+        for c in count.iter_mut() {
+            (*c, sum) = (sum, sum + *c);
+        }
+        for e in v.iter() {
+            let d = digit(e);
+            out[count[d]] = *e;
+            count[d] += 1;
+        }
+        std::mem::swap(v, &mut out);
+    }
+    debug_assert!(v.is_sorted());
 }
 
 fn push_events(list: &mut Vec<Event>, axis: usize, tri: u32, b: &Aabb) {
@@ -249,11 +288,12 @@ impl AxisCost {
 
     /// Cost of the plane at `pos` with `nl` and `nr` triangles on the two sides.
     #[inline]
-    fn cost(&self, pos: f32, nl: usize, nr: usize) -> f32 {
+    fn cost(&self, pos: f32, nl: u32, nr: u32) -> f32 {
         let sa_l = self.cap + (pos - self.min) * self.ring;
         let sa_r = self.cap + (self.max - pos) * self.ring;
         let cost = self.c_trav + self.c_isect_per_sa * (sa_l * nl as f32 + sa_r * nr as f32);
-        if nl == 0 || nr == 0 { cost * self.empty_factor } else { cost }
+        let factor = if nl == 0 || nr == 0 { self.empty_factor } else { 1.0 };
+        cost * factor
     }
 }
 
@@ -270,7 +310,7 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
     }
     let mut best_cost = p.c_isect * task.n as f32;
     let mut best = None;
-    let mut consider = |ac: &AxisCost, axis: usize, pos: f32, nl: usize, np: usize, nr: usize| {
+    let mut consider = |ac: &AxisCost, axis: usize, pos: f32, nl: u32, np: u32, nr: u32| {
         let c = ac.cost(pos, nl + np, nr);
         if c < best_cost {
             best_cost = c;
@@ -293,18 +333,21 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
                 }
                 let ac = AxisCost::new(p, b, axis);
                 let ev = &task.events[axis];
-                let (mut nl, mut nr) = (0usize, task.n);
+                // Counts fit `u32`: triangle ids do (see `KdNode`).
+                let (mut nl, mut nr) = (0u32, task.n as u32);
                 let mut i = 0;
                 while i < ev.len() {
-                    let pos = ev[i].pos;
-                    let mut count = [0usize; 3];
-                    for kind in [END, PLANAR, START] {
-                        while i < ev.len() && ev[i].pos == pos && ev[i].kind() == kind {
-                            count[kind as usize] += 1;
-                            i += 1;
-                        }
+                    // Only the counts at a position matter, so its events are tallied by kind without a branch
+                    // on the kind (ends and starts interleave at random).
+                    let (pos, key) = (ev[i].pos(), ev[i].pos_key());
+                    let (mut ne, mut np, mut ns) = (0u32, 0u32, 0u32);
+                    while i < ev.len() && ev[i].pos_key() == key {
+                        let kind = ev[i].kind();
+                        ne += (kind == END) as u32;
+                        np += (kind == PLANAR) as u32;
+                        ns += (kind == START) as u32;
+                        i += 1;
                     }
-                    let (ne, np, ns) = (count[END as usize], count[PLANAR as usize], count[START as usize]);
                     nr -= ne + np;
                     if pos > lo && pos < hi {
                         consider(&ac, axis, pos, nl, np, nr);
@@ -317,13 +360,13 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
             let axis = b.longest_axis();
             let pos = b.center()[axis];
             if pos > b.min[axis] && pos < b.max[axis] {
-                let (mut nl, mut np, mut nr) = (0, 0, 0);
+                let (mut nl, mut np, mut nr) = (0u32, 0u32, 0u32);
                 for e in &task.events[axis] {
                     match e.kind() {
-                        START if e.pos < pos => nl += 1,
-                        END if e.pos > pos => nr += 1,
-                        PLANAR if e.pos < pos => nl += 1,
-                        PLANAR if e.pos > pos => nr += 1,
+                        START if e.pos() < pos => nl += 1,
+                        END if e.pos() > pos => nr += 1,
+                        PLANAR if e.pos() < pos => nl += 1,
+                        PLANAR if e.pos() > pos => nr += 1,
                         PLANAR => np += 1,
                         _ => {}
                     }
@@ -338,33 +381,40 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
 /// Distributes the node's events to its children (Wald and Havran 2006, section 4.3).
 fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Task, Task) {
     let (axis, pos) = (split.axis, split.pos);
+    let pos_key = ordered_bits(pos);
     let side = &mut scratch.side;
     // One sweep classifies every triangle: a start event comes before its end event, so the start sets the
     // side to right-only or both, and the end turns "both" into left-only when it lies at or before `pos`.
+    // Starts and ends interleave at random, so the kind picks among precomputed sides without a branch.
+    // A triangle's side is final at its end or planar event, where it is counted.
+    let straddlers = &mut scratch.straddlers;
+    straddlers.clear();
+    let (mut nl, mut nr) = (0, 0);
     for e in &task.events[axis] {
         let s = &mut side[e.tri()];
-        match e.kind() {
-            START => *s = if e.pos >= pos { RIGHT } else { BOTH },
-            END if e.pos <= pos => *s = LEFT,
-            PLANAR if e.pos < pos || (e.pos == pos && split.planar_left) => *s = LEFT,
-            PLANAR => *s = RIGHT,
-            _ => {}
+        let at = e.pos_key();
+        let at_start = if at >= pos_key { RIGHT } else { BOTH };
+        let at_end = if at <= pos_key { LEFT } else { *s };
+        let planar = if at < pos_key || (at == pos_key && split.planar_left) { LEFT } else { RIGHT };
+        let kind = e.kind();
+        *s = if kind == START {
+            at_start
+        } else if kind == END {
+            at_end
+        } else {
+            planar
+        };
+        let counted = kind != START;
+        nl += (counted && *s == LEFT) as usize;
+        nr += (counted && *s == RIGHT) as usize;
+        if counted && *s == BOTH {
+            straddlers.push(e.tri() as u32);
         }
     }
     let (mut lb, mut rb) = (task.bounds, task.bounds);
     lb.max[axis] = pos;
     rb.min[axis] = pos;
 
-    let straddlers = &mut scratch.straddlers;
-    straddlers.clear();
-    let (mut nl, mut nr) = (0, 0);
-    for e in task.events[axis].iter().filter(|e| e.kind() != END) {
-        match side[e.tri()] {
-            LEFT => nl += 1,
-            RIGHT => nr += 1,
-            _ => straddlers.push(e.tri() as u32),
-        }
-    }
     let (mut new_l, mut new_r) = (std::mem::take(&mut scratch.new_l), std::mem::take(&mut scratch.new_r));
     new_l.iter_mut().chain(new_r.iter_mut()).for_each(Vec::clear);
     for &t in straddlers.iter() {
@@ -385,12 +435,12 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Ta
     let mut left: Events = Default::default();
     let mut right: Events = Default::default();
     for a in 0..3 {
-        new_l[a].sort_unstable_by_key(|e| e.key());
-        new_r[a].sort_unstable_by_key(|e| e.key());
-        // Reserving the parent's size for both children over-allocates, but memory never touched costs next
-        // to nothing, while counting first would take two more passes over the events.
-        left[a] = scratch.take(task.events[a].len() + new_l[a].len());
-        right[a] = scratch.take(task.events[a].len() + new_r[a].len());
+        new_l[a].sort_unstable();
+        new_r[a].sort_unstable();
+        // Sizing both children for all of the parent's events over-allocates, but counting first would take
+        // two more passes over the events.
+        left[a] = scratch.take(task.events[a].len() + 1);
+        right[a] = scratch.take(task.events[a].len() + 1);
         split_events(&task.events[a], &scratch.side, &new_l[a], &new_r[a], &mut left[a], &mut right[a]);
     }
     (scratch.new_l, scratch.new_r) = (new_l, new_r);
@@ -400,7 +450,12 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Ta
 }
 
 /// Sends each event of `old` to the side of its triangle (dropping the straddlers' old events) and merges in
-/// the straddlers' new, sorted events, in one pass that keeps both outputs sorted by [`Event::key`].
+/// the straddlers' new, sorted events, keeping both outputs sorted. `left` and `right`
+/// come with at least `old.len() + 1` slots and leave with their events.
+///
+/// The sides of the other axes' events are in no order a branch predictor could learn, so every event is
+/// written to both outputs and only the counts advance by its side; the few new events are then merged in
+/// from the back, which moves only the events that sort after the first of them.
 fn split_events(
     old: &[Event],
     side: &[u8],
@@ -409,27 +464,111 @@ fn split_events(
     left: &mut Vec<Event>,
     right: &mut Vec<Event>,
 ) {
-    let (mut i, mut j) = (0, 0);
+    let (mut nl, mut nr) = (0, 0);
     for &e in old {
-        let key = e.key();
-        match side[e.tri()] {
-            LEFT => {
-                while i < new_l.len() && new_l[i].key() < key {
-                    left.push(new_l[i]);
-                    i += 1;
-                }
-                left.push(e);
-            }
-            RIGHT => {
-                while j < new_r.len() && new_r[j].key() < key {
-                    right.push(new_r[j]);
-                    j += 1;
-                }
-                right.push(e);
-            }
-            _ => {}
+        let s = side[e.tri()];
+        left[nl] = e;
+        right[nr] = e;
+        nl += (s == LEFT) as usize;
+        nr += (s == RIGHT) as usize;
+    }
+    merge_from_back(left, nl, new_l);
+    merge_from_back(right, nr, new_r);
+}
+
+/// Makes `v` the sorted merge of its first `n` events (sorted) and `new` (sorted).
+fn merge_from_back(v: &mut Vec<Event>, n: usize, new: &[Event]) {
+    v.resize(n + new.len(), Event::BLANK);
+    let (mut i, mut j) = (n, new.len());
+    while j > 0 {
+        let k = i + j - 1;
+        if i > 0 && v[i - 1] > new[j - 1] {
+            v[k] = v[i - 1];
+            i -= 1;
+        } else {
+            v[k] = new[j - 1];
+            j -= 1;
         }
     }
-    left.extend_from_slice(&new_l[i..]);
-    right.extend_from_slice(&new_r[j..]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic pseudo-random sequence (xorshift).
+    fn numbers(seed: u32, n: usize) -> Vec<u32> {
+        let mut x = seed.max(1);
+        (0..n)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                x
+            })
+            .collect()
+    }
+
+    #[test]
+    fn events_order_by_position_then_kind_and_keep_their_fields() {
+        let positions = [-3.5e30f32, -2.0, -1.0, -f32::MIN_POSITIVE, 0.0, f32::MIN_POSITIVE, 1.0, 7.25e29];
+        let mut events = Vec::new();
+        for (k, &p) in positions.iter().enumerate() {
+            for kind in [START, END, PLANAR] {
+                events.push(Event::new(p, (k as u32 * 7919) % (1 << 30), kind));
+            }
+        }
+        for e in &events {
+            let k = positions.iter().position(|&p| p == e.pos()).unwrap();
+            assert_eq!(e.tri(), (k * 7919) % (1 << 30));
+        }
+        assert_eq!(Event::new(-0.0, 5, START), Event::new(0.0, 5, START), "-0 and +0 are one position");
+        let mut sorted = events.clone();
+        sorted.sort_unstable();
+        for w in sorted.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            assert!(a.pos() <= b.pos(), "{} then {}", a.pos(), b.pos());
+            if a.pos() == b.pos() {
+                assert!(a.kind() <= b.kind(), "end < planar < start at one position");
+            }
+        }
+        assert_eq!(Event::new(1.0, (1 << 30) - 1, START).tri(), (1 << 30) - 1);
+    }
+
+    #[test]
+    fn the_radix_sort_gives_the_comparison_sort_order() {
+        let r = numbers(7, 30_000);
+        // Few distinct positions, so that many events share position and kind and the stability shows.
+        let mut v: Vec<Event> =
+            (0..r.len()).map(|i| Event::new((r[i] % 97) as f32 * 0.37 - 18.0, i as u32, r[i] % 3)).collect();
+        let mut expected = v.clone();
+        expected.sort_unstable();
+        sort_root_events(&mut v);
+        assert_eq!(v, expected);
+    }
+
+    #[test]
+    fn split_events_sends_each_side_its_events_and_merges_the_new_ones_in_order() {
+        let r = numbers(11, 4000);
+        let n_tris = 500;
+        let mut old: Vec<Event> =
+            (0..2000).map(|i| Event::new((r[i] % 300) as f32 - 150.0, r[i + 2000] % n_tris, r[i] % 3)).collect();
+        old.sort_unstable();
+        let side: Vec<u8> = (0..n_tris as usize).map(|t| (r[t] % 3) as u8).collect();
+        let fresh = |seed: u32| {
+            let mut v: Vec<Event> =
+                numbers(seed, 60).iter().map(|&x| Event::new((x % 400) as f32 - 200.0, x % n_tris, x % 3)).collect();
+            v.sort_unstable();
+            v
+        };
+        let (new_l, new_r) = (fresh(3), fresh(5));
+        let (mut left, mut right) = (vec![Event::BLANK; old.len() + 1], vec![Event::BLANK; old.len() + 1]);
+        split_events(&old, &side, &new_l, &new_r, &mut left, &mut right);
+        for (out, new, keep) in [(&left, &new_l, LEFT), (&right, &new_r, RIGHT)] {
+            let mut expected: Vec<Event> = old.iter().copied().filter(|e| side[e.tri()] == keep).collect();
+            expected.extend_from_slice(new);
+            expected.sort_unstable();
+            assert_eq!(*out, expected);
+        }
+    }
 }

@@ -12,8 +12,9 @@ use crate::aabb::Aabb;
 /// intersected with the box are returned instead, so clipping never loses a triangle that overlaps the box
 /// (a larger box only costs a little tree quality).
 pub fn clipped_bounds(tri: &[glam::Vec3; 3], bx: &Aabb) -> Option<Aabb> {
-    let mut poly = [DVec3::ZERO; 9];
-    let mut tmp = [DVec3::ZERO; 9];
+    let (mut buf_a, mut buf_b) = ([DVec3::ZERO; 9], [DVec3::ZERO; 9]);
+    // Each clip reads one buffer and writes the other; the two swap roles instead of copying back.
+    let (mut poly, mut tmp) = (&mut buf_a, &mut buf_b);
     for (p, v) in poly.iter_mut().zip(tri) {
         *p = v.as_dvec3();
     }
@@ -25,8 +26,8 @@ pub fn clipped_bounds(tri: &[glam::Vec3; 3], bx: &Aabb) -> Option<Aabb> {
         for (lower, plane) in [(true, lo[axis]), (false, hi[axis])] {
             let crosses = if lower { (own.min[axis] as f64) < plane } else { (own.max[axis] as f64) > plane };
             if crosses && n > 0 {
-                n = clip_plane(&poly[..n], &mut tmp, axis, plane, lower);
-                poly[..n].copy_from_slice(&tmp[..n]);
+                n = clip_plane(&poly[..n], tmp, axis, plane, lower);
+                std::mem::swap(&mut poly, &mut tmp);
             }
         }
     }
@@ -63,10 +64,14 @@ fn clip_plane(input: &[DVec3], out: &mut [DVec3; 9], axis: usize, plane: f64, lo
     let inside = |p: &DVec3| {
         if lower { p[axis] >= plane } else { p[axis] <= plane }
     };
+    let Some(&last) = input.last() else {
+        return 0;
+    };
     let mut n = 0;
-    for i in 0..input.len() {
-        let a = input[i];
-        let b = input[(i + 1) % input.len()];
+    // Edges from each vertex's predecessor to it (the polygon starts one vertex later than `input`, the same
+    // points), which spares a modulo per vertex.
+    let mut a = last;
+    for &b in input {
         let (ia, ib) = (inside(&a), inside(&b));
         if ia {
             out[n] = a;
@@ -79,6 +84,7 @@ fn clip_plane(input: &[DVec3], out: &mut [DVec3; 9], axis: usize, plane: f64, lo
             out[n] = p;
             n += 1;
         }
+        a = b;
     }
     n
 }
