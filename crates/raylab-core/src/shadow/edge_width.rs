@@ -69,7 +69,10 @@ impl EdgeWidth {
     /// Records a crossing found in the current leaf.
     pub fn add(&mut self, c: Crossing) {
         self.seen.push(c.tri);
-        self.pending.push(c);
+        // Pending crossings stay sorted farthest first (by distance, then triangle id), so that groups come
+        // off the end; the list holds a handful at most, so a linear insertion beats sorting at each commit.
+        let at = self.pending.iter().position(|p| farther(c, *p)).unwrap_or(self.pending.len());
+        self.pending.insert(at, c);
     }
 
     /// Commits, in distance order, the pending crossings that no later leaf can join: those well before `t`
@@ -79,12 +82,17 @@ impl EdgeWidth {
     /// Crossings at one place (within [`SAME_PLACE`]) form a group, handled the same whatever order they were
     /// found in: same-facing members are one crossing; a group with both facings is an exit and an entry
     /// (inside) or an entry and an exit (outside, a graze).
+    #[inline]
     pub fn commit(&mut self, t: f32, tris: &TriangleSoup) -> bool {
-        if self.pending.is_empty() {
-            return self.done();
+        // Most leaves leave nothing pending; the call is then a check.
+        if !self.pending.is_empty() {
+            self.commit_pending(t, tris);
         }
-        // Farthest first, so groups come off the end.
-        self.pending.sort_unstable_by(|a, b| b.t.total_cmp(&a.t).then(b.tri.cmp(&a.tri)));
+        self.done()
+    }
+
+    /// [`EdgeWidth::commit`]'s work on a non-empty pending list.
+    fn commit_pending(&mut self, t: f32, tris: &TriangleSoup) {
         while let Some(&first) = self.pending.last() {
             let end = first.t + tolerance(first.t);
             if t.is_finite() && end + tolerance(end) > t {
@@ -114,7 +122,6 @@ impl EdgeWidth {
                 (None, None) => {}
             }
         }
-        self.done()
     }
 
     /// Enters or leaves an occluder at `c`, measuring the chord on leaving.
@@ -149,6 +156,11 @@ impl EdgeWidth {
             self.widest / self.radius
         }
     }
+}
+
+/// True when crossing `a` sorts before `b` in the pending list: farther, or as far with a larger triangle id.
+fn farther(a: Crossing, b: Crossing) -> bool {
+    b.t.total_cmp(&a.t).then(b.tri.cmp(&a.tri)).is_lt()
 }
 
 /// True when two triangles have a corner in common (exactly the same position).
