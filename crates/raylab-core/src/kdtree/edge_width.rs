@@ -24,7 +24,7 @@ use crate::triangle::RayShear;
 
 use super::KdTree;
 use super::mono::{Next, SPLIT_SLACK};
-use super::packet::{Front, PacketLeaf};
+use super::packet::{Front, PacketLeaf, PacketStack};
 
 impl KdTree {
     /// Traces an edge-width shadow ray (from the shaded point toward the light) and returns its occlusion in
@@ -69,6 +69,7 @@ impl KdTree {
         // -infinity), keeping their order (neighbours are coherent) within a group.
         let mut order: Vec<(usize, u32)> = rays.iter().map(|r| r.dir.is_negative_bitmask()).enumerate().collect();
         order.sort_by_key(|&(_, s)| s);
+        let mut stack = PacketStack::default();
         let mut start = 0;
         while start < order.len() {
             let sign = order[start].1;
@@ -89,7 +90,7 @@ impl KdTree {
             stats.rays += group.len() as u64;
             stats.packets += 1;
             let mut walk = EdgeWalks { tree: self, p: &p, states: &mut *states, tests: 0 };
-            self.traverse_packet(&p, Front::Signs(sign as usize), stats, &mut walk);
+            self.traverse_packet(&p, Front::Signs(sign as usize), &mut stack, stats, &mut walk);
             stats.isect_tests += walk.tests;
             for (s, &(i, _)) in states.iter_mut().zip(group) {
                 s.commit(f32::INFINITY, self.triangles());

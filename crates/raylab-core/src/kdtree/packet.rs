@@ -87,13 +87,18 @@ impl<V: Vf32> PacketLeaf<V> for Blockers<'_, V> {
     }
 }
 
-const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
+/// A packet walk's traversal stack, kept by the caller and reused from packet to packet: an array on the
+/// walk's own stack would be initialised for every packet (a few kilobytes with eight-lane entries, more
+/// than the whole walk of a coherent shadow packet costs), while this one is allocated once and grows to
+/// the tree's depth (each inner node pushes at most one entry).
+pub struct PacketStack<V: Vf32> {
+    entries: Vec<Entry<V>>,
+}
 
-/// A fixed-size traversal stack (no allocation per packet); each inner node pushes at most one entry, so the
-/// depth limit bounds it.
-struct Stack<V: Vf32> {
-    entries: [Entry<V>; STACK],
-    len: usize,
+impl<V: Vf32> Default for PacketStack<V> {
+    fn default() -> Self {
+        Self { entries: Vec::with_capacity(KdParams::DEPTH_LIMIT as usize + 4) }
+    }
 }
 
 /// Lanes whose interval is non-empty, allowing the same slack as single-ray traversal.
@@ -106,17 +111,28 @@ impl KdTree {
     /// Closest hits of a packet's rays, written to `hits` (whose `t` may start below the rays' `tmax` to
     /// search only closer hits). Counts nodes, leaves and tests; the caller counts rays and packets.
     #[inline(always)]
-    pub fn intersect_packet<V: Vf32>(&self, p: &RayPacket<V>, hits: &mut PacketHits<V>, stats: &mut TraversalStats) {
+    pub fn intersect_packet<V: Vf32>(
+        &self,
+        p: &RayPacket<V>,
+        hits: &mut PacketHits<V>,
+        stack: &mut PacketStack<V>,
+        stats: &mut TraversalStats,
+    ) {
         let mut leaf = ClosestHits { tree: self, p, hits, tests: 0 };
-        self.traverse_packet(p, Front::Origin, stats, &mut leaf);
+        self.traverse_packet(p, Front::Origin, stack, stats, &mut leaf);
         stats.isect_tests += leaf.tests;
     }
 
     /// The lanes whose rays are blocked within `(tmin, tmax]`.
     #[inline(always)]
-    pub fn occluded_packet<V: Vf32>(&self, p: &RayPacket<V>, stats: &mut TraversalStats) -> V::Mask {
+    pub fn occluded_packet<V: Vf32>(
+        &self,
+        p: &RayPacket<V>,
+        stack: &mut PacketStack<V>,
+        stats: &mut TraversalStats,
+    ) -> V::Mask {
         let mut leaf = Blockers { tree: self, p, blocked: V::Mask::from_bits(0), tests: 0 };
-        self.traverse_packet(p, Front::Origin, stats, &mut leaf);
+        self.traverse_packet(p, Front::Origin, stack, stats, &mut leaf);
         stats.isect_tests += leaf.tests;
         leaf.blocked
     }
@@ -127,6 +143,7 @@ impl KdTree {
         &self,
         p: &RayPacket<V>,
         front: Front,
+        stack: &mut PacketStack<V>,
         stats: &mut TraversalStats,
         leaf: &mut impl PacketLeaf<V>,
     ) {
@@ -141,7 +158,8 @@ impl KdTree {
         let nodes = self.nodes();
         let zero = V::splat(0.0);
         let inf = V::splat(f32::INFINITY);
-        let mut stack = Stack { entries: [Entry { node: 0, t_near: zero, t_far: zero }; STACK], len: 0 };
+        let stack = &mut stack.entries;
+        stack.clear();
         let mut node = 0usize;
         let (mut visited, mut leaves) = (0u64, 0u64);
         let mut done = V::Mask::from_bits(0);
@@ -176,7 +194,7 @@ impl KdTree {
                 if f_active.none() {
                     (node, t_near, t_far, active) = (back, b_near, b_far, b_active);
                     if b_active.none() {
-                        match self.pop_packet(&mut stack, p, done, &mut t_near, &mut t_far, &mut active, inf) {
+                        match self.pop_packet(stack, p, done, &mut t_near, &mut t_far, &mut active, inf) {
                             Some(next) => node = next,
                             None => break 'walk,
                         }
@@ -184,8 +202,7 @@ impl KdTree {
                     continue;
                 }
                 if b_active.any() {
-                    stack.entries[stack.len] = Entry { node: back as u32, t_near: b_near, t_far: b_far };
-                    stack.len += 1;
+                    stack.push(Entry { node: back as u32, t_near: b_near, t_far: b_far });
                 }
                 (node, t_near, t_far, active) = (front, f_near, f_far, f_active);
                 continue;
@@ -196,7 +213,7 @@ impl KdTree {
             if (p.valid & !done).none() {
                 break;
             }
-            match self.pop_packet(&mut stack, p, done, &mut t_near, &mut t_far, &mut active, limit) {
+            match self.pop_packet(stack, p, done, &mut t_near, &mut t_far, &mut active, limit) {
                 Some(next) => node = next,
                 None => break,
             }
@@ -210,7 +227,7 @@ impl KdTree {
     #[inline(always)]
     fn pop_packet<V: Vf32>(
         &self,
-        stack: &mut Stack<V>,
+        stack: &mut Vec<Entry<V>>,
         p: &RayPacket<V>,
         done: V::Mask,
         t_near: &mut V,
@@ -218,9 +235,7 @@ impl KdTree {
         active: &mut V::Mask,
         limit: V,
     ) -> Option<usize> {
-        while stack.len > 0 {
-            stack.len -= 1;
-            let e = stack.entries[stack.len];
+        while let Some(e) = stack.pop() {
             let a = p.valid & !done & nonempty(e.t_near, e.t_far) & nonempty(e.t_near, limit);
             if a.any() {
                 (*t_near, *t_far, *active) = (e.t_near, e.t_far, a);

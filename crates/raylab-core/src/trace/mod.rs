@@ -18,6 +18,7 @@ use serde::Serialize;
 use crate::dacrt::{Dacrt, DacrtParams};
 use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
+use crate::kdtree::packet::PacketStack;
 use crate::mbvh::Mbvh;
 use crate::method::Method;
 use crate::packet::{Cone, Cone4};
@@ -367,8 +368,9 @@ impl<'a> Tracer<'a> {
 
     #[inline(always)]
     fn packets_intersect<V: Vf32>(&self, tile: &mut PacketTile<V>, stats: &mut TraversalStats) {
+        let mut stack = PacketStack::default();
         for (p, h) in tile.packets.iter().zip(tile.hits.iter_mut()) {
-            self.tree.intersect_packet(p, h, stats);
+            self.tree.intersect_packet(p, h, &mut stack, stats);
         }
     }
 
@@ -429,8 +431,9 @@ impl<'a> Tracer<'a> {
             },
             _ => leftover = Some(all.clone()),
         }
+        let mut stack = PacketStack::default();
         for j in leftover.unwrap_or_default() {
-            blocked[j] = self.tree.occluded_packet(&tile.packets[j], stats);
+            blocked[j] = self.tree.occluded_packet(&tile.packets[j], &mut stack, stats);
         }
         for (j, b) in blocked.iter().enumerate() {
             let bits = b.bits();
