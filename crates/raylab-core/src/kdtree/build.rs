@@ -415,6 +415,8 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Ta
     lb.max[axis] = pos;
     rb.min[axis] = pos;
 
+    // Triangles wholly on one side: each has at most two events per axis.
+    let (only_l, only_r) = (nl, nr);
     let (mut new_l, mut new_r) = (std::mem::take(&mut scratch.new_l), std::mem::take(&mut scratch.new_r));
     new_l.iter_mut().chain(new_r.iter_mut()).for_each(Vec::clear);
     for &t in straddlers.iter() {
@@ -437,10 +439,9 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Ta
     for a in 0..3 {
         new_l[a].sort_unstable();
         new_r[a].sort_unstable();
-        // Sizing both children for all of the parent's events over-allocates, but counting first would take
-        // two more passes over the events.
-        left[a] = scratch.take(task.events[a].len() + 1);
-        right[a] = scratch.take(task.events[a].len() + 1);
+        let old = task.events[a].len();
+        left[a] = scratch.take(old.min(2 * only_l) + 1);
+        right[a] = scratch.take(old.min(2 * only_r) + 1);
         split_events(&task.events[a], &scratch.side, &new_l[a], &new_r[a], &mut left[a], &mut right[a]);
     }
     (scratch.new_l, scratch.new_r) = (new_l, new_r);
@@ -451,7 +452,7 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Ta
 
 /// Sends each event of `old` to the side of its triangle (dropping the straddlers' old events) and merges in
 /// the straddlers' new, sorted events, keeping both outputs sorted. `left` and `right`
-/// come with at least `old.len() + 1` slots and leave with their events.
+/// come with at least one slot more than the old events they keep and leave with their events.
 ///
 /// The sides of the other axes' events are in no order a branch predictor could learn, so every event is
 /// written to both outputs and only the counts advance by its side; the few new events are then merged in
