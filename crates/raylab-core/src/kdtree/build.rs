@@ -13,7 +13,7 @@
 
 use glam::Vec3;
 
-use super::clip::clipped_bounds;
+use super::clip::split_clipped_bounds;
 use super::params::{KdParams, SplitStrategy};
 use crate::aabb::Aabb;
 
@@ -420,14 +420,14 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Ta
     let (mut new_l, mut new_r) = (std::mem::take(&mut scratch.new_l), std::mem::take(&mut scratch.new_r));
     new_l.iter_mut().chain(new_r.iter_mut()).for_each(Vec::clear);
     for &t in straddlers.iter() {
-        let tri = &ctx.tris[t as usize];
-        if let Some(b) = clipped_bounds(tri, &lb) {
+        let (l, r) = split_clipped_bounds(&ctx.tris[t as usize], &task.bounds, axis, pos);
+        if let Some(b) = l {
             nl += 1;
             for (a, list) in new_l.iter_mut().enumerate() {
                 push_events(list, a, t, &b);
             }
         }
-        if let Some(b) = clipped_bounds(tri, &rb) {
+        if let Some(b) = r {
             nr += 1;
             for (a, list) in new_r.iter_mut().enumerate() {
                 push_events(list, a, t, &b);
