@@ -109,10 +109,11 @@ impl KdTree {
         let Some((mut t_near, mut t_far)) = self.bounds().clip_ray(ray.origin, inv, ray.tmin, ray.tmax) else {
             return;
         };
-        let origin = ray.origin.to_array();
-        let inv = inv.to_array();
+        let (origin, inv) = (ray.origin.to_array(), inv.to_array());
         // Bit k is set when the direction is negative on axis k; then the right child is the near one.
         let neg = inv.iter().enumerate().fold(0usize, |m, (k, v)| m | ((v.is_sign_negative() as usize) << k));
+        // Origin and inverse direction side by side, so a node's axis fetches both in one load.
+        let line: [[f32; 2]; 3] = std::array::from_fn(|k| [origin[k], inv[k]]);
         let nodes = self.nodes();
         let mut stack = [Entry::default(); STACK];
         let mut sp = 0usize;
@@ -123,7 +124,8 @@ impl KdTree {
             visited += 1;
             if !n.is_leaf() {
                 let axis = n.axis();
-                let t_split = (n.split() - origin[axis]) * inv[axis];
+                let [o, iv] = line[axis];
+                let t_split = (n.split() - o) * iv;
                 let near = n.left() | ((neg >> axis) & 1);
                 let far = near ^ 1;
                 if t_split > t_far * (1.0 + SPLIT_SLACK) {
