@@ -2,7 +2,7 @@
 //! centroid axes, the halves built in parallel with rayon), then collapsed top-down into 4-wide nodes by
 //! repeatedly opening the child with the largest surface area (Wald et al. 2008, as the MBVH RS paper builds).
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::node::{EMPTY, MbvhNode};
 use crate::aabb::Aabb;
@@ -194,16 +194,22 @@ fn best_split(boxes: &[Aabb], centroids: &[Vec3], ids: &[u32], cb: &Aabb, bounds
     if scale == [0.0; 3] {
         return None;
     }
-    let mut bin_box = [[Aabb::EMPTY; BINS]; 3];
+    // Bin boxes as 16-byte vectors, so that growing one by a triangle's box is two SIMD min/max operations.
+    let mut bin_lo = [[Vec3A::INFINITY; BINS]; 3];
+    let mut bin_hi = [[Vec3A::NEG_INFINITY; BINS]; 3];
     let mut bin_n = [[0u32; BINS]; 3];
     for &i in ids {
         let (c, b) = (centroids[i as usize], boxes[i as usize]);
+        let (lo, hi) = (Vec3A::from(b.min), Vec3A::from(b.max));
         for a in 0..3 {
             let k = bin_of(c[a], cb.min[a], scale[a]);
-            bin_box[a][k] = bin_box[a][k].union(b);
+            bin_lo[a][k] = bin_lo[a][k].min(lo);
+            bin_hi[a][k] = bin_hi[a][k].max(hi);
             bin_n[a][k] += 1;
         }
     }
+    let bin_box: [[Aabb; BINS]; 3] =
+        std::array::from_fn(|a| std::array::from_fn(|k| Aabb { min: bin_lo[a][k].into(), max: bin_hi[a][k].into() }));
     let area = bounds.surface_area().max(f32::MIN_POSITIVE);
     let mut best: Option<Split> = None;
     for a in (0..3).filter(|&a| scale[a] > 0.0) {
