@@ -14,6 +14,19 @@ pub struct Aabb {
     pub max: Vec3,
 }
 
+/// Component `k` of `v`, read as an array element. glam's `Index` matches on `k`, a branch that traversal
+/// loops, where `k` is each node's split axis, mispredict often; this is a plain indexed load.
+#[inline(always)]
+pub fn coord(v: &Vec3, k: usize) -> f32 {
+    AsRef::<[f32; 3]>::as_ref(v)[k]
+}
+
+/// Mutable component `k` of `v` (see [`coord`]).
+#[inline(always)]
+pub fn coord_mut(v: &mut Vec3, k: usize) -> &mut f32 {
+    &mut AsMut::<[f32; 3]>::as_mut(v)[k]
+}
+
 impl Default for Aabb {
     fn default() -> Self {
         Self::EMPTY

@@ -77,6 +77,11 @@ impl Method {
         matches!(self, Method::Packet | Method::Frustum | Method::Mft | Method::Cone | Method::MftCone)
     }
 
+    /// True for the methods that trace a tile as bundles of packets (pyramid or cone frustums).
+    pub fn is_bundled(self) -> bool {
+        matches!(self, Method::Frustum | Method::Mft | Method::Cone | Method::MftCone)
+    }
+
     /// True for the methods whose cost depends on the tile size (frustums, ray streams, whose group is the
     /// tile, and DACRT, whose ray set is).
     pub fn uses_tiles(self) -> bool {

@@ -242,6 +242,12 @@ mod tests {
             }
             assert_eq!(a.reduce_min(), -2.0);
             assert_eq!(a.reduce_max(), 1.0);
+            assert!(V::splat(f32::NAN).reduce_min().is_nan() && V::splat(f32::NAN).reduce_max().is_nan());
+            let mut one = [f32::NAN; 8];
+            one[n - 1] = -3.5;
+            assert_eq!((V::from_slice(&one[..n]).reduce_min(), V::from_slice(&one[..n]).reduce_max()), (-3.5, -3.5));
+            let inf = V::from_slice(&[f32::INFINITY, f32::NEG_INFINITY, 4.0, 1.0, 9.0, -7.0, 2.0, 0.0][..n]);
+            assert_eq!((inf.reduce_min(), inf.reduce_max()), (f32::NEG_INFINITY, f32::INFINITY));
             let mut out = [0.0; 8];
             (a + b).write_to(&mut out[..n]);
             assert_eq!([out[0], out[n - 4]], [1.5, 1.5]);

@@ -84,13 +84,18 @@ impl F32x8 {
         a
     }
 
-    /// Folds the lanes pairwise (halves, then quarters, then the last two); `pick` must ignore a NaN operand
-    /// unless both are NaN, as the trait's reductions do.
+    /// Folds the lanes with `op` (a lane-wise min or max) in registers: halves, then quarters, then the last
+    /// two. NaN lanes are first replaced by `identity`, so they are ignored; all-NaN input gives NaN.
     #[inline(always)]
-    fn reduce(self, pick: impl Fn(f32, f32) -> f32) -> f32 {
-        let v = self.to_array();
-        let h = [pick(v[0], v[4]), pick(v[1], v[5]), pick(v[2], v[6]), pick(v[3], v[7])];
-        pick(pick(h[0], h[2]), pick(h[1], h[3]))
+    fn reduce(self, identity: f32, op: impl Fn(__m128, __m128) -> __m128) -> f32 {
+        avx!({
+            let ordered = _mm256_cmp_ps::<_CMP_ORD_Q>(self.0, self.0);
+            let v = _mm256_blendv_ps(_mm256_set1_ps(identity), self.0, ordered);
+            let m = op(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
+            let m = op(m, _mm_movehl_ps(m, m));
+            let m = op(m, _mm_movehdup_ps(m));
+            if _mm256_movemask_ps(ordered) == 0 { f32::NAN } else { _mm_cvtss_f32(m) }
+        })
     }
 }
 
@@ -146,11 +151,11 @@ impl Vf32 for F32x8 {
     }
     #[inline(always)]
     fn reduce_min(self) -> f32 {
-        self.reduce(|a, b| if a < b || b.is_nan() { a } else { b })
+        self.reduce(f32::INFINITY, |a, b| avx!(_mm_min_ps(a, b)))
     }
     #[inline(always)]
     fn reduce_max(self) -> f32 {
-        self.reduce(|a, b| if a > b || b.is_nan() { a } else { b })
+        self.reduce(f32::NEG_INFINITY, |a, b| avx!(_mm_max_ps(a, b)))
     }
     #[inline(always)]
     fn abs(self) -> Self {

@@ -11,8 +11,8 @@
 use raylab_simd::{VMask, Vf32};
 
 use super::mono::SPLIT_SLACK;
-use super::{KdParams, KdTree};
-use crate::aabb::Aabb;
+use super::{KdNode, KdParams, KdTree};
+use crate::aabb::{Aabb, coord};
 use crate::packet::{Bundle, PacketTile, intersect_packet, occlude_packet, overlaps_box};
 use crate::stats::TraversalStats;
 
@@ -21,31 +21,46 @@ struct Entry {
     node: u32,
     near: f32,
     far: f32,
-    bounds: Aabb,
 }
 
 const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 
-/// The children of an inner node as a bundle from `origin` meets them: the front child (on the origin's side,
-/// entered first, thesis 4.1.2) and its box, then the back child's box; the back child is `front ^ 1`.
+/// The child of an inner node that a bundle from `origin` meets first (on the origin's side, thesis 4.1.2);
+/// the other child is `front ^ 1`.
 #[inline(always)]
-pub(super) fn front_and_back(n: super::KdNode, origin: glam::Vec3, bounds: &Aabb) -> (usize, Aabb, Aabb) {
-    let (axis, split) = (n.axis(), n.split());
-    let origin_right = split - origin[axis] < 0.0;
-    let (mut l, mut r) = (*bounds, *bounds);
-    l.max[axis] = split;
-    r.min[axis] = split;
-    let front = n.left() | origin_right as usize;
-    if origin_right { (front, r, l) } else { (front, l, r) }
+pub(super) fn front_child(n: KdNode, origin: glam::Vec3) -> usize {
+    n.left() | (n.split() - coord(&origin, n.axis()) < 0.0) as usize
 }
 
-/// A leaf reached by a frustum walk: its triangle ids, its box, and the distance at which the bundle can
-/// first be inside it.
+/// A leaf reached by a frustum walk, and the distance at which the bundle can first be inside it.
+#[derive(Clone, Copy)]
 pub(super) struct Leaf<'a> {
     pub tree: &'a KdTree,
-    pub ids: std::ops::Range<usize>,
-    pub bounds: Aabb,
+    pub node: KdNode,
     pub near: f32,
+}
+
+/// The batched culling verdicts ([`crate::packet::BatchCull`]) of the last chunk of packets a leaf loop
+/// asked about, so a loop over packets in index order tests each chunk once.
+#[derive(Default)]
+struct BatchBits {
+    chunk: Option<usize>,
+    bits: u32,
+}
+
+impl BatchBits {
+    /// False when packet `j` of `tile` certainly has no ray inside `bounds` before its current hits; true
+    /// when it may, or when the tile has no batch data.
+    #[inline(always)]
+    fn may_enter<V: Vf32>(&mut self, tile: &PacketTile<V>, j: usize, bounds: &Aabb) -> bool {
+        let Some(batch) = &tile.batch else { return true };
+        let chunk = j / V::LANES;
+        if self.chunk != Some(chunk) {
+            self.chunk = Some(chunk);
+            self.bits = batch.maybe_inside::<V>(chunk, bounds, &tile.farthest_hit, SPLIT_SLACK);
+        }
+        self.bits >> (j % V::LANES) & 1 == 1
+    }
 }
 
 /// Tests `leaf` against packets `set` of `tile`, culling packets whose rays miss its box when `cull` is on.
@@ -58,16 +73,18 @@ pub(super) fn leaf_intersect<V: Vf32>(
     cull: bool,
     stats: &mut TraversalStats,
 ) -> bool {
-    let (tree, bounds) = (leaf.tree, &leaf.bounds);
-    let ids = &tree.tri_ids()[leaf.ids.clone()];
+    let tree = leaf.tree;
+    let ids = &tree.tri_ids()[leaf.node.leaf_range()];
     if ids.is_empty() {
         return false;
     }
+    let bounds = &tree.leaf_bounds(leaf.node);
     let mut changed = false;
     let done_before = leaf.near * (1.0 - SPLIT_SLACK);
+    let mut batch = BatchBits::default();
     for &j in set {
         // A packet whose rays all hit before the leaf starts: nothing here can be closer.
-        if tile.farthest_hit[j] < done_before {
+        if tile.farthest_hit[j] < done_before || (cull && !batch.may_enter(tile, j, bounds)) {
             stats.packets_culled += 1;
             continue;
         }
@@ -102,11 +119,13 @@ pub(super) fn leaf_occlude<V: Vf32>(
     blocked: &mut [V::Mask],
     stats: &mut TraversalStats,
 ) {
-    let (tree, bounds) = (leaf.tree, &leaf.bounds);
-    let ids = &tree.tri_ids()[leaf.ids.clone()];
+    let tree = leaf.tree;
+    let ids = &tree.tri_ids()[leaf.node.leaf_range()];
     if ids.is_empty() {
         return;
     }
+    let bounds = &tree.leaf_bounds(leaf.node);
+    let mut batch = BatchBits::default();
     for &j in set {
         let p = &tile.packets[j];
         let mut open = p.valid & !blocked[j];
@@ -114,6 +133,10 @@ pub(super) fn leaf_occlude<V: Vf32>(
             continue;
         }
         if cull {
+            if !batch.may_enter(tile, j, bounds) {
+                stats.packets_culled += 1;
+                continue;
+            }
             open = open & overlaps_box(p, bounds, p.tmax, SPLIT_SLACK);
             if open.none() {
                 stats.packets_culled += 1;
@@ -226,31 +249,31 @@ impl KdTree {
             return;
         }
         let nodes = self.nodes();
-        let mut stack = [Entry { node: 0, near: 0.0, far: 0.0, bounds: Aabb::EMPTY }; STACK];
+        let mut stack = [Entry { node: 0, near: 0.0, far: 0.0 }; STACK];
         let mut sp = 0usize;
         let (t_min, t_max) = f.t_range();
         let origin = f.origin();
-        let (mut node, mut near, mut far, mut bounds) = (0usize, t_min, t_max, self.bounds());
+        let (mut node, mut near, mut far) = (0usize, t_min, t_max);
         let (mut visited, mut leaves) = (0u64, 0u64);
         'walk: loop {
             let n = nodes[node];
             visited += 1;
             if !n.is_leaf() {
                 let (lo, hi) = f.crossing(n.axis(), n.split());
-                let (front, front_box, back_box) = front_and_back(n, origin, &bounds);
+                let front = front_child(n, origin);
                 if hi < near * (1.0 - SPLIT_SLACK) {
-                    (node, bounds) = (front ^ 1, back_box);
+                    node = front ^ 1;
                 } else if lo > far * (1.0 + SPLIT_SLACK) {
-                    (node, bounds) = (front, front_box);
+                    node = front;
                 } else {
-                    stack[sp] = Entry { node: (front ^ 1) as u32, near: lo.max(near), far, bounds: back_box };
+                    stack[sp] = Entry { node: (front ^ 1) as u32, near: lo.max(near), far };
                     sp += 1;
-                    (node, far, bounds) = (front, hi.min(far), front_box);
+                    (node, far) = (front, hi.min(far));
                 }
                 continue;
             }
             leaves += 1;
-            let (limit, stop) = leaf.visit(&Leaf { tree: self, ids: n.leaf_range(), bounds, near }, stats);
+            let (limit, stop) = leaf.visit(&Leaf { tree: self, node: n, near }, stats);
             if stop {
                 break;
             }
@@ -261,7 +284,7 @@ impl KdTree {
                 sp -= 1;
                 let e = stack[sp];
                 if e.near * (1.0 - SPLIT_SLACK) <= limit {
-                    (node, near, far, bounds) = (e.node as usize, e.near, e.far, e.bounds);
+                    (node, near, far) = (e.node as usize, e.near, e.far);
                     break;
                 }
             }

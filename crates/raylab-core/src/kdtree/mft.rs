@@ -9,10 +9,10 @@
 
 use raylab_simd::{VMask, Vf32};
 
-use super::frustum::{Leaf, front_and_back, hit_limit, leaf_intersect, leaf_occlude, open_lanes};
+use super::frustum::{Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude, open_lanes};
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
-use crate::aabb::Aabb;
+use crate::aabb::coord;
 use crate::packet::{Bundle4, Frustum, MAX_LANES, PacketTile, bundle_lanes, map3};
 use crate::stats::TraversalStats;
 
@@ -72,7 +72,7 @@ impl<V: Vf32> Bundle4<V> for Frustum4<V> {
     }
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (V, V) {
-        let dist = split - self.origin[k];
+        let dist = split - coord(&self.origin, k);
         let slack = self.origin_slack;
         if dist > slack {
             (V::splat(dist - slack) * self.pos_near[k], V::splat(dist + slack) * self.pos_far[k])
@@ -103,7 +103,7 @@ impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32) {
         for (i, set) in self.sets.iter().enumerate() {
-            let leaf = Leaf { near: near[i], ids: leaf.ids.clone(), ..*leaf };
+            let leaf = Leaf { near: near[i], ..*leaf };
             if active >> i & 1 == 1 && leaf_intersect(&leaf, self.tile, set, self.cull, stats) {
                 self.limit[i] = hit_limit(self.tile, set);
             }
@@ -126,7 +126,7 @@ impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32) {
         for (i, set) in self.sets.iter().enumerate() {
             if active >> i & 1 == 1 {
-                let leaf = Leaf { near: near[i], ids: leaf.ids.clone(), ..*leaf };
+                let leaf = Leaf { near: near[i], ..*leaf };
                 leaf_occlude(&leaf, self.tile, set, self.cull, self.blocked, stats);
                 if open_lanes(self.tile, set, self.blocked) == 0 {
                     self.done |= 1 << i;
@@ -143,7 +143,6 @@ struct Entry<V: Vf32> {
     near: V,
     far: V,
     active: V::Mask,
-    bounds: Aabb,
 }
 
 const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
@@ -187,12 +186,11 @@ impl KdTree {
         let hi_slack = V::splat(1.0 + SPLIT_SLACK);
         let nodes = self.nodes();
         let zero = V::splat(0.0);
-        let mut stack =
-            [Entry { node: 0, near: zero, far: zero, active: V::Mask::from_bits(0), bounds: Aabb::EMPTY }; STACK];
+        let mut stack = [Entry { node: 0, near: zero, far: zero, active: V::Mask::from_bits(0) }; STACK];
         let mut sp = 0usize;
         let (t_min, t_max) = f.t_range();
         let origin = f.origin();
-        let (mut node, mut near, mut far, mut bounds) = (0usize, t_min, t_max, self.bounds());
+        let (mut node, mut near, mut far) = (0usize, t_min, t_max);
         let mut active = f.valid();
         let mut done = V::Mask::from_bits(0);
         let (mut visited, mut leaves) = (0u64, 0u64);
@@ -201,7 +199,7 @@ impl KdTree {
             visited += 1;
             if !n.is_leaf() {
                 let (lo, hi) = f.crossing(n.axis(), n.split());
-                let (front, front_box, back_box) = front_and_back(n, origin, &bounds);
+                let front = front_child(n, origin);
                 // Per frustum: all its rays cross before its interval (back only) or after it (front only).
                 let back_only = hi.lt(near * lo_slack);
                 let front_only = lo.gt(far * hi_slack);
@@ -209,15 +207,14 @@ impl KdTree {
                 let b_active = active & !front_only;
                 let (f_far, b_near) = (hi.min(far), lo.max(near));
                 if f_active.none() {
-                    (node, near, active, bounds) = (front ^ 1, b_near, b_active, back_box);
+                    (node, near, active) = (front ^ 1, b_near, b_active);
                     continue;
                 }
                 if b_active.any() {
-                    stack[sp] =
-                        Entry { node: (front ^ 1) as u32, near: b_near, far, active: b_active, bounds: back_box };
+                    stack[sp] = Entry { node: (front ^ 1) as u32, near: b_near, far, active: b_active };
                     sp += 1;
                 }
-                (node, far, active, bounds) = (front, f_far, f_active, front_box);
+                (node, far, active) = (front, f_far, f_active);
                 continue;
             }
             leaves += 1;
@@ -225,7 +222,7 @@ impl KdTree {
             near.write_to(&mut near_lanes[..V::LANES]);
             let near4 = std::array::from_fn(|i| near_lanes[i]);
             // Each frustum lane has its own entry distance: the visitor sets `near` from `near4` per lane.
-            let leaf_at = Leaf { tree: self, ids: n.leaf_range(), bounds, near: 0.0 };
+            let leaf_at = Leaf { tree: self, node: n, near: 0.0 };
             let (limit, finished) = leaf.visit(&leaf_at, near4, (active & !done).bits(), stats);
             done = done | V::Mask::from_bits(finished);
             if (f.valid() & !done).none() {
@@ -239,7 +236,7 @@ impl KdTree {
                 let e = stack[sp];
                 let a = e.active & !done & (e.near * lo_slack).le(limit);
                 if a.any() {
-                    (node, near, far, active, bounds) = (e.node as usize, e.near, e.far, a, e.bounds);
+                    (node, near, far, active) = (e.node as usize, e.near, e.far, a);
                     break;
                 }
             }

@@ -4,6 +4,7 @@ mod build;
 mod clip;
 mod edge_width;
 pub mod frustum;
+mod leaf_bounds;
 pub mod mft;
 pub mod mono;
 mod node;
@@ -21,6 +22,7 @@ use crate::aabb::Aabb;
 use crate::scene::Scene;
 use crate::triangle::TriangleSoup;
 use build::BuildNode;
+use leaf_bounds::LeafBounds;
 
 /// Why a kd-tree could not be built.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -57,6 +59,7 @@ pub struct KdTree {
     tri_ids: Vec<u32>,
     tris: TriangleSoup,
     bounds: Aabb,
+    leaf_bounds: LeafBounds,
     params: KdParams,
     build_time: Duration,
 }
@@ -96,7 +99,28 @@ impl KdTree {
             }
         }
         let bounds = if tris.is_empty() { Aabb::EMPTY } else { scene_bounds.padded(Self::ROOT_PADDING) };
-        Ok(Self { nodes, tri_ids: out.tri_ids, tris, bounds, params: *params, build_time: start.elapsed() })
+        let leaf_bounds = LeafBounds::default();
+        let mut tree = Self {
+            nodes,
+            tri_ids: out.tri_ids,
+            tris,
+            bounds,
+            leaf_bounds,
+            params: *params,
+            build_time: Duration::ZERO,
+        };
+        tree.leaf_bounds = LeafBounds::new(tree.tri_ids.len(), &tree.tri_ids, &tree.tris, |f| {
+            tree.visit(|_, cell, n| f(cell, n));
+        });
+        tree.build_time = start.elapsed();
+        Ok(tree)
+    }
+
+    /// The box a ray must reach to hit anything in leaf `n`, which must be a non-empty leaf: its cell
+    /// intersected with its triangles' bounds, padded a little (for packet/leaf culling).
+    #[inline(always)]
+    pub fn leaf_bounds(&self, n: KdNode) -> Aabb {
+        self.leaf_bounds.get(n)
     }
 
     /// The nodes; the root is node 0.

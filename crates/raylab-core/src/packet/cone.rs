@@ -16,6 +16,7 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
 use super::{Disc, RayPacket, bundle_lanes, map3, tile::Bundle, tile::Bundle4};
+use crate::aabb::coord;
 
 /// A cone bounding a bundle of rays from one origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -123,7 +124,7 @@ impl Bundle for Cone {
     /// Listing 4.3 with the omni-directional rule: the two edge depths, negative ones made infinite, sorted.
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
-        let dist = split - self.origin[k];
+        let dist = split - coord(&self.origin, k);
         let slack = self.origin_slack;
         if dist.abs() <= slack {
             return (0.0, f32::INFINITY);
@@ -194,7 +195,7 @@ impl<V: Vf32> Bundle4<V> for Cone4<V> {
     }
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (V, V) {
-        let dist = split - self.origin[k];
+        let dist = split - coord(&self.origin, k);
         let slack = self.origin_slack;
         if dist.abs() <= slack {
             return (V::splat(0.0), V::splat(f32::INFINITY));

@@ -1,6 +1,7 @@
 //! Ray packets: a few rays in structure-of-arrays form, traced together with SIMD (Tsakok 2008, 2.3.1 and
 //! 4.1.2; Listings 2.5-2.6 show the SoA layout).
 
+mod batch_cull;
 mod cone;
 mod disc;
 mod tile;
@@ -11,6 +12,7 @@ use raylab_simd::{VMask, Vf32};
 
 use crate::ray::{Hit, Ray};
 
+pub use batch_cull::BatchCull;
 pub use cone::{Cone, Cone4};
 pub use disc::Disc;
 pub use tile::{Bundle, Bundle4, Frustum, PacketTile, overlaps_box, slab_interval};

@@ -4,8 +4,8 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{Disc, PacketHits, RayPacket, map3};
-use crate::aabb::Aabb;
+use super::{BatchCull, Disc, PacketHits, RayPacket, map3};
+use crate::aabb::{Aabb, coord};
 use crate::ray::Ray;
 
 /// The packets of a `width x height` tile in row-major pixel order, each `w = V::LANES / 2` pixels wide and
@@ -16,8 +16,11 @@ pub struct PacketTile<V: Vf32> {
     /// Closest hits (or, for occlusion, the per-lane state) of each packet.
     pub hits: Vec<PacketHits<V>>,
     /// Per packet, the farthest current hit distance over its rays (infinite while one has none): a leaf
-    /// that starts beyond it cannot improve any of the packet's hits.
+    /// that starts beyond it cannot improve any of the packet's hits. Padded with -inf to whole vectors, so
+    /// [`BatchCull`] loads it a vector at a time.
     pub farthest_hit: Vec<f32>,
+    /// The batched culling data, once [`PacketTile::share_origin`] has found the rays' common origin.
+    pub batch: Option<BatchCull>,
     /// Index of each packet's lane-0 pixel in the tile, and the tile width, to map lanes back to pixels.
     pub origin_pixel: Vec<(usize, usize)>,
     /// Packet columns and rows.
@@ -59,7 +62,15 @@ impl<V: Vf32> PacketTile<V> {
             hits.push(PacketHits::new(p));
             farthest_hit.push(V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max());
         }
-        Self { packets, hits, farthest_hit, origin_pixel, cols, rows, width, height }
+        farthest_hit.resize(packets.len().div_ceil(V::LANES) * V::LANES, f32::NEG_INFINITY);
+        Self { packets, hits, farthest_hit, batch: None, origin_pixel, cols, rows, width, height }
+    }
+
+    /// Prepares batched packet/leaf culling ([`BatchCull`]) for rays that all start at `origin` (the caller
+    /// has checked that they do).
+    #[inline(always)]
+    pub fn share_origin(&mut self, origin: Vec3) {
+        self.batch = Some(BatchCull::new(origin, &self.packets));
     }
 
     /// Calls `f(pixel_index, lane)` for every lane of packet `j` that holds a ray.
@@ -321,7 +332,7 @@ impl Frustum {
     /// mean "some ray never crosses in front of the origin".
     #[inline(always)]
     pub fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
-        let dist = split - self.origin[k];
+        let dist = split - coord(&self.origin, k);
         let slack = self.origin_slack;
         if dist > slack {
             ((dist - slack) * self.pos_near[k], (dist + slack) * self.pos_far[k])

@@ -324,6 +324,12 @@ impl<'a> Tracer<'a> {
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         // Tiles no bundle covers are traced as packets (after the match, so the packet kernel is inlined once).
         let cull = self.options.cull;
+        if cull
+            && self.options.method.is_bundled()
+            && let Some(origin) = common_origin(&tile, &all)
+        {
+            tile.share_origin(origin);
+        }
         let bundled = match self.options.method {
             Method::Frustum => {
                 let f = common_origin_frustum(&tile, &all);
@@ -384,9 +390,15 @@ impl<'a> Tracer<'a> {
         out: &mut [bool],
         stats: &mut TraversalStats,
     ) {
-        let tile = PacketTile::<V>::new(rays, width, height);
+        let mut tile = PacketTile::<V>::new(rays, width, height);
         let mut blocked = vec![V::Mask::from_bits(0); tile.packets.len()];
         let all: Vec<usize> = (0..tile.packets.len()).collect();
+        if self.options.cull
+            && self.options.method.is_bundled()
+            && let Some(origin) = common_origin(&tile, &all)
+        {
+            tile.share_origin(origin);
+        }
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         let limit = self.options.shadow_spread_limit;

@@ -1,0 +1,167 @@
+//! Packet/leaf culling (thesis 4.1.4) for a whole batch of packets at once.
+//!
+//! When every ray of a tile starts at one origin, a packet is bounded by the range of its rays' inverse
+//! directions on each axis, and a leaf box by its two planes' distances from that origin on each axis. The
+//! products of those ranges bound the distances at which any of the packet's rays can be inside the box's
+//! slabs (interval arithmetic, as in the MFT frustum test), so one SIMD test over `LANES` packets, one packet
+//! per lane, rejects most packets that cannot reach a leaf before the per-ray test of
+//! [`super::overlaps_box`] runs on the rest. The test is conservative: rounding is monotone, so each bound
+//! is at least as wide as the per-ray test's own arithmetic, and a packet it keeps is still culled per ray.
+
+use glam::Vec3;
+use raylab_simd::{VMask, Vf32};
+
+use super::{MAX_LANES, RayPacket};
+use crate::aabb::Aabb;
+
+/// The culling data of up to [`MAX_LANES`] packets, one per lane, relative to the tile's common origin.
+#[derive(Clone, Copy, Debug)]
+struct Chunk {
+    /// Smallest inverse direction per axis; NaN where the packet's rays go both ways on the axis or one of
+    /// them is parallel to it (the axis then bounds nothing: the SSE min/max rule drops NaN), or where the
+    /// lane holds no packet.
+    inv_lo: [[f32; MAX_LANES]; 3],
+    /// Largest inverse direction per axis (NaN where `inv_lo` is).
+    inv_hi: [[f32; MAX_LANES]; 3],
+    /// Smallest `tmin` of the packet's rays (+inf for an empty packet or an empty lane).
+    tmin: [f32; MAX_LANES],
+}
+
+/// Batched culling data of a tile's packets, whose rays all start at `origin`.
+#[derive(Clone, Debug)]
+pub struct BatchCull {
+    origin: Vec3,
+    chunks: Vec<Chunk>,
+}
+
+impl BatchCull {
+    /// The batch data of `packets`, whose valid rays all start at `origin`, in chunks of `V::LANES` packets.
+    #[inline(always)]
+    pub fn new<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>]) -> Self {
+        let empty = Chunk {
+            inv_lo: [[f32::NAN; MAX_LANES]; 3],
+            inv_hi: [[f32::NAN; MAX_LANES]; 3],
+            tmin: [f32::INFINITY; MAX_LANES],
+        };
+        let mut chunks = vec![empty; packets.len().div_ceil(V::LANES)];
+        let (inf, ninf) = (V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
+        for (j, p) in packets.iter().enumerate() {
+            if p.valid.none() {
+                continue;
+            }
+            let (c, i) = (&mut chunks[j / V::LANES], j % V::LANES);
+            c.tmin[i] = V::select(p.valid, p.tmin, inf).reduce_min();
+            for k in 0..3 {
+                let lo = V::select(p.valid, p.inv[k], inf).reduce_min();
+                let hi = V::select(p.valid, p.inv[k], ninf).reduce_max();
+                if (lo > 0.0 && hi < f32::INFINITY) || (hi < 0.0 && lo > f32::NEG_INFINITY) {
+                    (c.inv_lo[k][i], c.inv_hi[k][i]) = (lo, hi);
+                }
+            }
+        }
+        BatchCull { origin, chunks }
+    }
+
+    /// The common origin of the packets.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// Bits (lane `i` for packet `chunk * LANES + i`) of the packets of one chunk that may have a ray inside
+    /// box `b` at a distance in `[tmin, limit]`, allowing the relative `slack` of the per-ray test; `limit`
+    /// holds the packets' farthest current hits, padded to whole chunks.
+    #[inline(always)]
+    pub fn maybe_inside<V: Vf32>(&self, chunk: usize, b: &Aabb, limit: &[f32], slack: f32) -> u32 {
+        let c = &self.chunks[chunk];
+        let mut t0 = V::from_slice(&c.tmin[..V::LANES]);
+        let mut t1 = V::from_slice(&limit[chunk * V::LANES..(chunk + 1) * V::LANES]);
+        for k in 0..3 {
+            let (lo, hi) = (V::from_slice(&c.inv_lo[k][..V::LANES]), V::from_slice(&c.inv_hi[k][..V::LANES]));
+            let near = V::splat(b.min[k] - self.origin[k]);
+            let far = V::splat(b.max[k] - self.origin[k]);
+            let (a, bb, cc, d) = (near * lo, near * hi, far * lo, far * hi);
+            // NaN lanes (unbounded axes) leave `t0` and `t1` as they are: `x.max(y)` keeps `y` when `x` is NaN.
+            t0 = a.min(bb).min(cc.min(d)).max(t0);
+            t1 = a.max(bb).max(cc.max(d)).min(t1);
+        }
+        (t0 * V::splat(1.0 - slack)).le(t1 * V::splat(1.0 + slack)).bits()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use raylab_simd::scalar::F32x4;
+
+    use super::*;
+    use crate::packet::overlaps_box;
+    use crate::ray::Ray;
+
+    /// A small deterministic generator (no dependency for a test).
+    fn next(state: &mut u64) -> f32 {
+        *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((*state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+    }
+
+    /// Packets of random rays from one origin: some all one way on an axis, some mixed, some with a zero
+    /// direction component.
+    fn packets(origin: Vec3, n: usize, state: &mut u64) -> Vec<RayPacket<F32x4>> {
+        (0..n)
+            .map(|i| {
+                let centre = Vec3::new(next(state), next(state), next(state));
+                let rays: Vec<Option<Ray>> = (0..4)
+                    .map(|l| {
+                        let mut d = centre + 0.2 * Vec3::new(next(state), next(state), next(state));
+                        if i % 7 == 3 {
+                            d[l % 3] = 0.0;
+                        }
+                        (i % 5 != 4 || l != 2).then(|| Ray::segment(origin, d, 0.01 * l as f32, 50.0))
+                    })
+                    .collect();
+                RayPacket::new(&rays)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn never_culls_a_packet_the_per_ray_test_keeps() {
+        let mut state = 7u64;
+        let origin = Vec3::new(0.3, -0.2, 0.1);
+        let ps = packets(origin, 203, &mut state);
+        let batch = BatchCull::new(origin, &ps);
+        let mut limit: Vec<f32> =
+            ps.iter().map(|p| F32x4::select(p.valid, p.tmax, F32x4::splat(f32::NEG_INFINITY)).reduce_max()).collect();
+        limit.resize(ps.len().div_ceil(4) * 4, f32::NEG_INFINITY);
+        let (mut kept, mut culled) = (0, 0);
+        for i in 0..400 {
+            let c = Vec3::new(next(&mut state), next(&mut state), next(&mut state)) * 3.0;
+            let e = Vec3::new(next(&mut state), next(&mut state), next(&mut state)).abs() * 0.8;
+            // Some boxes touch the origin's planes exactly.
+            let b = if i % 11 == 5 { Aabb::new(origin, origin + e) } else { Aabb::new(c - e, c + e) };
+            for (j, p) in ps.iter().enumerate() {
+                let coarse = batch.maybe_inside::<F32x4>(j / 4, &b, &limit, 1e-5) >> (j % 4) & 1 == 1;
+                let exact = overlaps_box(p, &b, p.tmax, 1e-5).any();
+                assert!(coarse || !exact, "packet {j} culled but a ray reaches {b:?}");
+                if coarse && exact {
+                    kept += 1;
+                } else if !coarse {
+                    culled += 1;
+                }
+            }
+        }
+        assert!(kept > 1000 && culled > 20_000, "kept {kept}, culled {culled}");
+    }
+
+    #[test]
+    fn padding_and_empty_packets_are_culled() {
+        let origin = Vec3::ZERO;
+        let empty = RayPacket::<F32x4>::new(&[]);
+        let one = RayPacket::<F32x4>::new(&[Some(Ray::segment(origin, Vec3::X, 0.0, 10.0))]);
+        let ps = [one, empty];
+        let batch = BatchCull::new(origin, &ps);
+        let limit = [10.0, f32::NEG_INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY];
+        let b = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+        assert_eq!(batch.maybe_inside::<F32x4>(0, &b, &limit, 1e-5), 0b0001);
+        let behind = Aabb::new(Vec3::new(-3.0, -1.0, -1.0), Vec3::new(-2.0, 1.0, 1.0));
+        assert_eq!(batch.maybe_inside::<F32x4>(0, &behind, &limit, 1e-5), 0);
+    }
+}
