@@ -54,30 +54,46 @@ impl<V: Vf32> RayPacket<V> {
     #[inline(always)]
     pub fn new(rays: &[Option<Ray>]) -> Self {
         assert!(rays.len() <= V::LANES && V::LANES <= MAX_LANES);
-        Self::gather(|i| rays.get(i).copied().flatten().filter(Ray::is_valid))
+        Self::gather(|i| rays.get(i).copied().flatten())
     }
 
-    /// Packs lane `i` from `ray(i)`, straight from the caller's rays (no array of them first), which must be
-    /// `None` or a ray with [`Ray::is_valid`] (callers whose rays are known valid skip the check); a `None`
-    /// lane stays empty: it holds a ray along +z, as [`Self::from_lanes`] accepts.
+    /// Packs lane `i` from `ray(i)`, straight from the caller's rays (no array of them first); a `None` lane,
+    /// or one whose ray fails [`Ray::is_valid`] (checked for all lanes at once), stays empty: it holds a ray
+    /// along +z, as [`Self::from_lanes`] accepts. Each ray is copied as two rows of four floats, which a
+    /// register transpose turns into the packet's vectors, rather than written lane by lane.
     #[inline(always)]
     pub fn gather(ray: impl Fn(usize) -> Option<Ray>) -> Self {
-        let mut f = [[0.0f32; MAX_LANES]; 8];
-        f[5] = [1.0; MAX_LANES];
-        f[7] = [f32::INFINITY; MAX_LANES];
-        let mut valid = 0u32;
-        for i in 0..V::LANES {
-            let Some(r) = ray(i) else { continue };
-            debug_assert!(r.is_valid());
-            valid |= 1 << i;
-            let values = [r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z, r.tmin, r.tmax];
-            for (field, v) in f.iter_mut().zip(values) {
-                field[i] = v;
+        const EMPTY: [[f32; 4]; 2] = [[0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, f32::INFINITY]];
+        let mut rows = [EMPTY; MAX_LANES];
+        let mut present = 0u32;
+        for (i, row) in rows.iter_mut().enumerate().take(V::LANES) {
+            if let Some(r) = ray(i) {
+                present |= 1 << i;
+                *row = [[r.origin.x, r.origin.y, r.origin.z, r.dir.x], [r.dir.y, r.dir.z, r.tmin, r.tmax]];
             }
         }
-        let org = [load(&f[0]), load(&f[1]), load(&f[2])];
-        let dir = [load(&f[3]), load(&f[4]), load(&f[5])];
-        Self::from_lanes(org, dir, load(&f[6]), load(&f[7]), valid)
+        let first: [&[f32; 4]; MAX_LANES] = std::array::from_fn(|i| &rows[i][0]);
+        let second: [&[f32; 4]; MAX_LANES] = std::array::from_fn(|i| &rows[i][1]);
+        let [ox, oy, oz, dx] = V::transpose_rows(&first);
+        let [dy, dz, tmin, tmax] = V::transpose_rows(&second);
+        // `Ray::is_valid` per lane: finite origin and direction (`|x| < inf` fails for infinities and NaN), a
+        // non-zero direction, no NaN interval end.
+        let (zero, inf) = (V::splat(0.0), V::splat(f32::INFINITY));
+        let finite = |v: V| v.abs().lt(inf);
+        let ok = finite(ox)
+            & finite(oy)
+            & finite(oz)
+            & finite(dx)
+            & finite(dy)
+            & finite(dz)
+            & dx.abs().max(dy.abs()).max(dz.abs()).gt(zero)
+            & tmin.eq(tmin)
+            & tmax.eq(tmax);
+        let valid = V::Mask::from_bits(present) & ok;
+        let lanes = |v: V, empty: f32| V::select(valid, v, V::splat(empty));
+        let org = [lanes(ox, 0.0), lanes(oy, 0.0), lanes(oz, 0.0)];
+        let dir = [lanes(dx, 0.0), lanes(dy, 0.0), lanes(dz, 1.0)];
+        Self::from_lanes(org, dir, lanes(tmin, 0.0), lanes(tmax, f32::INFINITY), valid.bits())
     }
 
     /// The packet of the rays already in lanes: origins, directions, intervals, and the `valid` lanes (bit `i`
@@ -163,12 +179,6 @@ pub(crate) fn bundle_lanes<V: Vf32, B>(bundles: &[Option<B>; 4], field: &dyn Fn(
         *lane = b.as_ref().map_or(empty, field);
     }
     V::from_slice(&a[..V::LANES])
-}
-
-/// The first `V::LANES` values of `field` as a vector.
-#[inline(always)]
-fn load<V: Vf32>(field: &[f32; MAX_LANES]) -> V {
-    V::from_slice(&field[..V::LANES])
 }
 
 /// Closest hits of a packet, per lane.

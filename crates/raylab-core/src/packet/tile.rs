@@ -50,7 +50,7 @@ impl<V: Vf32> PacketTile<V> {
             for bx in 0..cols {
                 packets.push(RayPacket::gather(|i| {
                     let (x, y) = (pw * bx + i % pw, ph * by + i / pw);
-                    if x < width && y < height { rays[y * width + x].filter(Ray::is_valid) } else { None }
+                    if x < width && y < height { rays[y * width + x] } else { None }
                 }));
                 origin_pixel.push((pw * bx, ph * by));
             }
