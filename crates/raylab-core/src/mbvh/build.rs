@@ -2,7 +2,7 @@
 //! centroid axes, the halves built in parallel with rayon), then collapsed top-down into 4-wide nodes by
 //! repeatedly opening the child with the largest surface area (Wald et al. 2008, as the MBVH RS paper builds).
 
-use glam::{Vec3, Vec3A};
+use glam::{UVec3, Vec3, Vec3A};
 
 use super::node::{EMPTY, MbvhNode};
 use crate::aabb::Aabb;
@@ -51,7 +51,8 @@ pub fn build(boxes: &[Aabb], centroids: &[Vec3]) -> Built {
     let root = if ids.is_empty() {
         Bin::Leaf { bounds: Aabb::EMPTY, first: 0, count: 0 }
     } else {
-        split(boxes, centroids, &mut ids, 0, 0, &mut count)
+        let extent = Extent::of(boxes, centroids, &ids);
+        split(boxes, centroids, &mut ids, extent, 0, 0, &mut count)
     };
     let mut nodes = vec![MbvhNode::empty()];
     match &root {
@@ -124,49 +125,105 @@ fn collapse(n: &Bin, at: usize, nodes: &mut Vec<MbvhNode>) {
     debug_assert!(nodes[at].child.iter().any(|&c| c != EMPTY));
 }
 
-/// Builds the binary subtree over `ids` (which start at `offset` in the final id array), partitioning `ids`
-/// in place.
-fn split(boxes: &[Aabb], centroids: &[Vec3], ids: &mut [u32], offset: u32, depth: u32, nodes: &mut usize) -> Bin {
+/// The box of some triangles and the box of their centroids.
+#[derive(Clone, Copy)]
+struct Extent {
+    bounds: Aabb,
+    centroids: Aabb,
+}
+
+impl Extent {
+    /// The extent of triangles `ids`, by a pass over them.
+    fn of(boxes: &[Aabb], centroids: &[Vec3], ids: &[u32]) -> Self {
+        ids.iter().fold(Extent { bounds: Aabb::EMPTY, centroids: Aabb::EMPTY }, |e, &i| Extent {
+            bounds: e.bounds.union(boxes[i as usize]),
+            centroids: e.centroids.grow(centroids[i as usize]),
+        })
+    }
+}
+
+/// Builds the binary subtree over `ids` (which start at `offset` in the final id array and span `extent`),
+/// partitioning `ids` in place. A binned split hands each child its extent: the triangle boxes from the
+/// bins, the centroid boxes from the partition pass, so no level makes a pass of its own to find them.
+fn split(
+    boxes: &[Aabb],
+    centroids: &[Vec3],
+    ids: &mut [u32],
+    extent: Extent,
+    offset: u32,
+    depth: u32,
+    nodes: &mut usize,
+) -> Bin {
     *nodes += 1;
-    let bounds = ids.iter().fold(Aabb::EMPTY, |b, &i| b.union(boxes[i as usize]));
+    let bounds = extent.bounds;
     let n = ids.len();
     let leaf = Bin::Leaf { bounds, first: offset, count: n as u32 };
     if n <= 2 {
         return leaf;
     }
-    let cb = ids.iter().fold(Aabb::EMPTY, |b, &i| b.grow(centroids[i as usize]));
-    // Deep in the tree (lopsided SAH splits on pathological input), halve the list to bound the depth.
-    let mid = if depth >= MAX_SAH_DEPTH {
-        Some(n / 2)
+    // Deep in the tree (lopsided SAH splits on pathological input), the list is halved to bound the depth.
+    let binned = if depth >= MAX_SAH_DEPTH {
+        None
     } else {
-        best_split(boxes, centroids, ids, &cb, bounds).and_then(|split| {
-            // Split when it beats a leaf, and always when the leaf would be too big.
-            (split.cost < n as f32 || n > MAX_LEAF).then(|| {
-                let (axis, lo, scale) = (split.axis, cb.min[split.axis], split.scale);
-                partition(ids, |i| bin_of(centroids[i as usize][axis], lo, scale) <= split.bin)
-            })
-        })
+        // Split when it beats a leaf, and always when the leaf would be too big.
+        best_split(boxes, centroids, ids, &extent.centroids, bounds).filter(|s| s.cost < n as f32 || n > MAX_LEAF)
     };
-    let mid = match mid {
-        Some(m) if m > 0 && m < n => m,
-        _ if n > MAX_LEAF => n / 2, // all centroids in one bin: split the list in half
-        _ => return leaf,
+    let parts = match binned {
+        Some(s) => {
+            let (axis, lo) = (s.axis, extent.centroids.min[s.axis]);
+            let (mut left_c, mut right_c) = (Aabb::EMPTY, Aabb::EMPTY);
+            let mut mid = 0;
+            for j in 0..n {
+                let c = centroids[ids[j] as usize];
+                if bin_of(c[axis], lo, s.scale) <= s.bin {
+                    left_c = left_c.grow(c);
+                    ids.swap(mid, j);
+                    mid += 1;
+                } else {
+                    right_c = right_c.grow(c);
+                }
+            }
+            (mid > 0 && mid < n).then_some((
+                mid,
+                Extent { bounds: s.left, centroids: left_c },
+                Extent { bounds: s.right, centroids: right_c },
+            ))
+        }
+        None if n <= MAX_LEAF => return leaf,
+        None => None,
+    };
+    let (mid, left_extent, right_extent) = match parts {
+        Some(p) => p,
+        // All centroids in one bin (or the depth cap): split the list in half.
+        None if n > MAX_LEAF => {
+            let mid = n / 2;
+            (mid, Extent::of(boxes, centroids, &ids[..mid]), Extent::of(boxes, centroids, &ids[mid..]))
+        }
+        None => return leaf,
     };
     let (left, right) = ids.split_at_mut(mid);
     let (mut nl, mut nr) = (0, 0);
+    let right_offset = offset + mid as u32;
     let (l, r) = if n >= PARALLEL_MIN {
         rayon::join(
-            || split(boxes, centroids, left, offset, depth + 1, &mut nl),
-            || split(boxes, centroids, right, offset + mid as u32, depth + 1, &mut nr),
+            || split(boxes, centroids, left, left_extent, offset, depth + 1, &mut nl),
+            || split(boxes, centroids, right, right_extent, right_offset, depth + 1, &mut nr),
         )
     } else {
         (
-            split(boxes, centroids, left, offset, depth + 1, &mut nl),
-            split(boxes, centroids, right, offset + mid as u32, depth + 1, &mut nr),
+            split(boxes, centroids, left, left_extent, offset, depth + 1, &mut nl),
+            split(boxes, centroids, right, right_extent, right_offset, depth + 1, &mut nr),
         )
     };
     *nodes += nl + nr;
     Bin::Inner { bounds, children: Box::new([l, r]) }
+}
+
+/// [`Aabb::surface_area`] of the box `[lo, hi]`, on 16-byte vectors (the same operations in the same order).
+#[inline]
+fn surface_area(lo: Vec3A, hi: Vec3A) -> f32 {
+    let e = (hi - lo).max(Vec3A::ZERO);
+    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
 }
 
 #[inline]
@@ -181,6 +238,9 @@ struct Split {
     scale: f32,
     /// SAH cost in units of triangle tests.
     cost: f32,
+    /// The boxes of the triangles on each side.
+    left: Aabb,
+    right: Aabb,
 }
 
 /// The cheapest binned split over all three centroid axes (axes where the centroids do not spread are
@@ -198,55 +258,47 @@ fn best_split(boxes: &[Aabb], centroids: &[Vec3], ids: &[u32], cb: &Aabb, bounds
     let mut bin_lo = [[Vec3A::INFINITY; BINS]; 3];
     let mut bin_hi = [[Vec3A::NEG_INFINITY; BINS]; 3];
     let mut bin_n = [[0u32; BINS]; 3];
+    // The three axes' bins at once, with `bin_of`'s arithmetic in each lane (so `partition` agrees).
+    let (origin, scale3, last) = (Vec3A::from(cb.min), Vec3A::from_array(scale), UVec3::splat(BINS as u32 - 1));
     for &i in ids {
-        let (c, b) = (centroids[i as usize], boxes[i as usize]);
+        let (c, b) = (Vec3A::from(centroids[i as usize]), &boxes[i as usize]);
         let (lo, hi) = (Vec3A::from(b.min), Vec3A::from(b.max));
-        for a in 0..3 {
-            let k = bin_of(c[a], cb.min[a], scale[a]);
+        let bins = ((c - origin) * scale3).as_uvec3().min(last).to_array();
+        for (a, &k) in bins.iter().enumerate() {
+            let k = k as usize;
             bin_lo[a][k] = bin_lo[a][k].min(lo);
             bin_hi[a][k] = bin_hi[a][k].max(hi);
             bin_n[a][k] += 1;
         }
     }
-    let bin_box: [[Aabb; BINS]; 3] =
-        std::array::from_fn(|a| std::array::from_fn(|k| Aabb { min: bin_lo[a][k].into(), max: bin_hi[a][k].into() }));
     let area = bounds.surface_area().max(f32::MIN_POSITIVE);
     let mut best: Option<Split> = None;
     for a in (0..3).filter(|&a| scale[a] > 0.0) {
-        // Sweep from the right to get the right-side areas, then from the left.
-        let mut right_area = [0.0f32; BINS];
+        // Sweep from the right to get the right-side boxes, then from the left.
+        let mut right = [(Vec3A::INFINITY, Vec3A::NEG_INFINITY); BINS];
         let mut right_n = [0u32; BINS];
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        let (mut lo, mut hi, mut cnt) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0);
         for b in (1..BINS).rev() {
-            acc = acc.union(bin_box[a][b]);
+            (lo, hi) = (lo.min(bin_lo[a][b]), hi.max(bin_hi[a][b]));
             cnt += bin_n[a][b];
-            right_area[b] = acc.surface_area();
+            right[b] = (lo, hi);
             right_n[b] = cnt;
         }
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        let (mut lo, mut hi, mut cnt) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0);
         for b in 0..BINS - 1 {
-            acc = acc.union(bin_box[a][b]);
+            (lo, hi) = (lo.min(bin_lo[a][b]), hi.max(bin_hi[a][b]));
             cnt += bin_n[a][b];
             if cnt == 0 || right_n[b + 1] == 0 {
                 continue;
             }
-            let cost = C_TRAV + (acc.surface_area() * cnt as f32 + right_area[b + 1] * right_n[b + 1] as f32) / area;
+            let (r_lo, r_hi) = right[b + 1];
+            let cost =
+                C_TRAV + (surface_area(lo, hi) * cnt as f32 + surface_area(r_lo, r_hi) * right_n[b + 1] as f32) / area;
             if best.as_ref().is_none_or(|s| cost < s.cost) {
-                best = Some(Split { axis: a, bin: b, scale: scale[a], cost });
+                let (left, right) = (Aabb::new(lo.into(), hi.into()), Aabb::new(r_lo.into(), r_hi.into()));
+                best = Some(Split { axis: a, bin: b, scale: scale[a], cost, left, right });
             }
         }
     }
     best
-}
-
-/// Moves the ids for which `left` holds to the front; returns how many there are.
-fn partition(ids: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
-    let mut i = 0;
-    for j in 0..ids.len() {
-        if left(ids[j]) {
-            ids.swap(i, j);
-            i += 1;
-        }
-    }
-    i
 }
