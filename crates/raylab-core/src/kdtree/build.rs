@@ -15,7 +15,7 @@ use glam::Vec3;
 
 use super::clip::split_clipped_bounds;
 use super::params::{KdParams, SplitStrategy};
-use crate::aabb::Aabb;
+use crate::aabb::{Aabb, coord, coord_mut};
 
 /// A node of the builder's tree. Children of an inner node are adjacent: `left` and `left + 1`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -184,11 +184,11 @@ fn sort_root_events(v: &mut Vec<Event>) {
 }
 
 fn push_events(list: &mut Vec<Event>, axis: usize, tri: u32, b: &Aabb) {
-    if b.min[axis] == b.max[axis] {
-        list.push(Event::new(b.min[axis], tri, PLANAR));
+    if coord(&b.min, axis) == coord(&b.max, axis) {
+        list.push(Event::new(coord(&b.min, axis), tri, PLANAR));
     } else {
-        list.push(Event::new(b.min[axis], tri, START));
-        list.push(Event::new(b.max[axis], tri, END));
+        list.push(Event::new(coord(&b.min, axis), tri, START));
+        list.push(Event::new(coord(&b.max, axis), tri, END));
     }
 }
 
@@ -276,8 +276,8 @@ impl AxisCost {
         let e = b.extent();
         let (e1, e2) = (e[(axis + 1) % 3], e[(axis + 2) % 3]);
         Self {
-            min: b.min[axis],
-            max: b.max[axis],
+            min: coord(&b.min, axis),
+            max: coord(&b.max, axis),
             cap: 2.0 * e1 * e2,
             ring: 2.0 * (e1 + e2),
             c_trav: p.c_trav,
@@ -327,7 +327,7 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
     match p.strategy {
         SplitStrategy::Sah => {
             for axis in 0..3 {
-                let (lo, hi) = (b.min[axis], b.max[axis]);
+                let (lo, hi) = (coord(&b.min, axis), coord(&b.max, axis));
                 if hi <= lo {
                     continue;
                 }
@@ -359,7 +359,7 @@ fn find_split(ctx: &Ctx, task: &Task) -> Option<Split> {
         SplitStrategy::Middle => {
             let axis = b.longest_axis();
             let pos = b.center()[axis];
-            if pos > b.min[axis] && pos < b.max[axis] {
+            if pos > coord(&b.min, axis) && pos < coord(&b.max, axis) {
                 let (mut nl, mut np, mut nr) = (0u32, 0u32, 0u32);
                 for e in &task.events[axis] {
                     match e.kind() {
@@ -412,8 +412,8 @@ fn partition(ctx: &Ctx, task: Task, split: &Split, scratch: &mut Scratch) -> (Ta
         }
     }
     let (mut lb, mut rb) = (task.bounds, task.bounds);
-    lb.max[axis] = pos;
-    rb.min[axis] = pos;
+    *coord_mut(&mut lb.max, axis) = pos;
+    *coord_mut(&mut rb.min, axis) = pos;
 
     // Triangles wholly on one side: each has at most two events per axis.
     let (only_l, only_r) = (nl, nr);

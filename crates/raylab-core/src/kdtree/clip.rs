@@ -2,7 +2,7 @@
 
 use glam::{DVec3, Vec3};
 
-use crate::aabb::Aabb;
+use crate::aabb::{Aabb, coord, coord_mut};
 
 /// Bounds of the part of triangle `tri` inside `bx`, or `None` if none of it is.
 ///
@@ -29,8 +29,8 @@ pub fn clipped_bounds(tri: &[Vec3; 3], bx: &Aabb) -> Option<Aabb> {
 /// arithmetic, shared by both sides), instead of clipping the triangle to each child box from scratch.
 pub fn split_clipped_bounds(tri: &[Vec3; 3], bx: &Aabb, axis: usize, pos: f32) -> (Option<Aabb>, Option<Aabb>) {
     let (mut lb, mut rb) = (*bx, *bx);
-    lb.max[axis] = pos;
-    rb.min[axis] = pos;
+    *coord_mut(&mut lb.max, axis) = pos;
+    *coord_mut(&mut rb.min, axis) = pos;
     let poly = clip_to_box(tri, bx);
     let points = poly.points();
     let plane = pos as f64;
@@ -93,7 +93,8 @@ fn clip_to_box(tri: &[Vec3; 3], bx: &Aabb) -> Polygon {
     let (lo, hi) = (bx.min.as_dvec3(), bx.max.as_dvec3());
     for axis in 0..3 {
         for (lower, plane) in [(true, lo[axis]), (false, hi[axis])] {
-            let crosses = if lower { (own.min[axis] as f64) < plane } else { (own.max[axis] as f64) > plane };
+            let crosses =
+                if lower { (coord(&own.min, axis) as f64) < plane } else { (coord(&own.max, axis) as f64) > plane };
             if crosses && n > 0 {
                 n = clip_plane(&poly[..n], tmp, axis, plane, lower);
                 std::mem::swap(&mut poly, &mut tmp);

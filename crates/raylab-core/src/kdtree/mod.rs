@@ -18,7 +18,7 @@ pub use stats::KdStats;
 
 use std::time::{Duration, Instant};
 
-use crate::aabb::Aabb;
+use crate::aabb::{Aabb, coord_mut};
 use crate::scene::Scene;
 use crate::triangle::TriangleSoup;
 use build::BuildNode;
@@ -170,8 +170,8 @@ impl KdTree {
             f(depth, &b, n);
             if !n.is_leaf() {
                 let (mut lb, mut rb) = (b, b);
-                lb.max[n.axis()] = n.split();
-                rb.min[n.axis()] = n.split();
+                *coord_mut(&mut lb.max, n.axis()) = n.split();
+                *coord_mut(&mut rb.min, n.axis()) = n.split();
                 stack.push((n.left() + 1, depth + 1, rb));
                 stack.push((n.left(), depth + 1, lb));
             }
