@@ -11,11 +11,14 @@
 //! Edge-width walks need each lane's leaves front to back, which the origin rule does not give when lanes
 //! start on both sides of a plane; their packets share direction signs and take the near child by sign
 //! ([`Front::Signs`]), the classic rule, under which every lane's cells come in its own distance order.
+//! Closest-hit and occlusion packets whose rays happen to share their signs (most coherent ones) walk the
+//! same way, with the classic interval step when no direction component is zero: the same intervals as the
+//! general step for such lanes, without its per-lane selects.
 
 use raylab_simd::{VMask, Vf32};
 
 use super::mono::SPLIT_SLACK;
-use super::{KdParams, KdTree};
+use super::{KdNode, KdParams, KdTree};
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet, slab_interval};
 use crate::stats::TraversalStats;
 
@@ -42,6 +45,24 @@ pub(super) enum Front {
     /// The child the shared direction signs meet first: bit `k` set when every lane's direction is
     /// negative on axis `k` (clear when every lane's is positive), as the sign of its inverse says.
     Signs(usize),
+}
+
+impl Front {
+    /// [`Front::Signs`] when the packet's rays share their direction signs (every lane's cells then come in
+    /// its own distance order, as with the origin rule), else [`Front::Origin`].
+    #[inline(always)]
+    pub(super) fn of<V: Vf32>(p: &RayPacket<V>) -> Front {
+        let (valid, zero) = (p.valid.bits(), V::splat(0.0));
+        let mut neg = 0;
+        for k in 0..3 {
+            match (p.inv[k].lt(zero) & p.valid).bits() {
+                0 => {}
+                bits if bits == valid => neg |= 1 << k,
+                _ => return Front::Origin,
+            }
+        }
+        Front::Signs(neg)
+    }
 }
 
 /// Closest hits, kept in `hits`.
@@ -107,6 +128,50 @@ fn nonempty<V: Vf32>(t_near: V, t_far: V) -> V::Mask {
     (t_near * V::splat(1.0 - SPLIT_SLACK)).le(t_far * V::splat(1.0 + SPLIT_SLACK))
 }
 
+/// The children of inner node `n` in the order a packet walks them, and each lane's interval in both: the
+/// child entered first, its intervals, the other child's intervals.
+type Step<V> = (usize, (V, V), (V, V));
+
+/// The general step (Listing 4.1 with the thesis's two modifications), for any mix of directions.
+#[inline(always)]
+fn origin_step<V: Vf32>(n: KdNode, p: &RayPacket<V>, front: Front, active: V::Mask, t_near: V, t_far: V) -> Step<V> {
+    let axis = n.axis();
+    let zero = V::splat(0.0);
+    let dist = V::splat(n.split()) - p.org[axis];
+    let d = dist * p.inv[axis];
+    // Modification 1: a plane behind the ray is never reached.
+    let d = V::select(d.lt(zero), V::splat(f32::INFINITY), d);
+    // Modification 2: the front child is on the origin's side; the first active lane decides for the packet,
+    // and lanes with origins on the other side swap their two intervals. An origin on the plane belongs to
+    // the side its ray leaves (crossing at t = 0 into the other). Under shared signs the near child is the
+    // front one, and a lane starting beyond the plane (which it never reaches) has all its interval in the
+    // far child.
+    let origin_right = dist.lt(zero) | (dist.eq(zero) & p.dir[axis].lt(zero));
+    let front_right = match front {
+        Front::Origin => origin_right.bits() >> active.bits().trailing_zeros() & 1 == 1,
+        Front::Signs(neg) => (neg >> axis) & 1 == 1,
+    };
+    let same = if front_right { origin_right } else { !origin_right };
+    let before = d.min(t_far);
+    let after = d.max(t_near);
+    (
+        n.left() | front_right as usize,
+        (V::select(same, t_near, after), V::select(same, before, t_far)),
+        (V::select(same, after, t_near), V::select(same, t_far, before)),
+    )
+}
+
+/// The classic step for lanes that share direction signs `neg` and have no zero direction component: the
+/// near child by sign, the near interval up to the plane and the far one from it. For such lanes it gives
+/// exactly [`origin_step`]'s intervals (a plane behind a lane leaves its near interval empty by itself)
+/// without the per-lane side selects.
+#[inline(always)]
+fn signs_step<V: Vf32>(n: KdNode, p: &RayPacket<V>, neg: usize, t_near: V, t_far: V) -> Step<V> {
+    let axis = n.axis();
+    let d = (V::splat(n.split()) - p.org[axis]) * p.inv[axis];
+    (n.left() | ((neg >> axis) & 1), (t_near, d.min(t_far)), (d.max(t_near), t_far))
+}
+
 impl KdTree {
     /// Closest hits of a packet's rays, written to `hits` (whose `t` may start below the rays' `tmax` to
     /// search only closer hits). Counts nodes, leaves and tests; the caller counts rays and packets.
@@ -119,7 +184,7 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let mut leaf = ClosestHits { tree: self, p, hits, tests: 0 };
-        self.traverse_packet(p, Front::Origin, stack, stats, &mut leaf);
+        self.traverse_packet(p, Front::of(p), stack, stats, &mut leaf);
         stats.isect_tests += leaf.tests;
     }
 
@@ -132,7 +197,7 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) -> V::Mask {
         let mut leaf = Blockers { tree: self, p, blocked: V::Mask::from_bits(0), tests: 0 };
-        self.traverse_packet(p, Front::Origin, stack, stats, &mut leaf);
+        self.traverse_packet(p, Front::of(p), stack, stats, &mut leaf);
         stats.isect_tests += leaf.tests;
         leaf.blocked
     }
@@ -156,7 +221,6 @@ impl KdTree {
             return;
         }
         let nodes = self.nodes();
-        let zero = V::splat(0.0);
         let inf = V::splat(f32::INFINITY);
         let stack = &mut stack.entries;
         stack.clear();
@@ -167,30 +231,13 @@ impl KdTree {
             let n = nodes[node];
             visited += 1;
             if !n.is_leaf() {
-                let axis = n.axis();
-                let dist = V::splat(n.split()) - p.org[axis];
-                let d = dist * p.inv[axis];
-                // Listing 4.1, modification 1: a plane behind the ray is never reached.
-                let d = V::select(d.lt(zero), inf, d);
-                // Modification 2: the front child is on the origin's side; the first active lane decides
-                // for the packet, and lanes with origins on the other side swap their two intervals.
-                // An origin on the plane belongs to the side its ray leaves (crossing at t = 0 into the other).
-                // Under shared signs the near child is the front one, and a lane starting beyond the plane
-                // (which it never reaches) has all its interval in the far child.
-                let origin_right = dist.lt(zero) | (dist.eq(zero) & p.dir[axis].lt(zero));
-                let front_right = match front {
-                    Front::Origin => origin_right.bits() >> active.bits().trailing_zeros() & 1 == 1,
-                    Front::Signs(neg) => (neg >> axis) & 1 == 1,
+                let (first, (f_near, f_far), (b_near, b_far)) = match front {
+                    Front::Signs(neg) if p.finite_inv => signs_step(n, p, neg, t_near, t_far),
+                    _ => origin_step(n, p, front, active, t_near, t_far),
                 };
-                let same = if front_right { origin_right } else { !origin_right };
-                let before = d.min(t_far);
-                let after = d.max(t_near);
-                let (f_near, f_far) = (V::select(same, t_near, after), V::select(same, before, t_far));
-                let (b_near, b_far) = (V::select(same, after, t_near), V::select(same, t_far, before));
                 let f_active = active & nonempty(f_near, f_far);
                 let b_active = active & nonempty(b_near, b_far);
-                let front = n.left() | front_right as usize;
-                let back = front ^ 1;
+                let back = first ^ 1;
                 if f_active.none() {
                     (node, t_near, t_far, active) = (back, b_near, b_far, b_active);
                     if b_active.none() {
@@ -204,7 +251,7 @@ impl KdTree {
                 if b_active.any() {
                     stack.push(Entry { node: back as u32, t_near: b_near, t_far: b_far });
                 }
-                (node, t_near, t_far, active) = (front, f_near, f_far, f_active);
+                (node, t_near, t_far, active) = (first, f_near, f_far, f_active);
                 continue;
             }
             leaves += 1;
