@@ -21,23 +21,15 @@ pub(super) struct LeafBounds {
 
 impl LeafBounds {
     /// The boxes of the leaves of a tree whose nodes `visit` enumerates with their cells.
-    pub(super) fn new(
-        refs: usize,
-        tri_ids: &[u32],
-        tris: &TriangleSoup,
-        visit: impl FnOnce(&mut dyn FnMut(&Aabb, KdNode)),
-    ) -> Self {
-        let mut lb = LeafBounds { slot: vec![u32::MAX; refs], boxes: Vec::new() };
+    pub(super) fn new(tri_ids: &[u32], tris: &TriangleSoup, visit: impl FnOnce(&mut dyn FnMut(&Aabb, KdNode))) -> Self {
+        let mut lb = LeafBounds { slot: vec![u32::MAX; tri_ids.len()], boxes: Vec::new() };
         visit(&mut |cell, n| {
             if !n.is_leaf() || n.leaf_range().is_empty() {
                 return;
             }
             let range = n.leaf_range();
             let start = range.start;
-            let extent = tri_ids[range].iter().fold(Aabb::EMPTY, |b, &t| {
-                let [a, c, d] = *tris.get(t);
-                b.union(Aabb::new(a.min(c).min(d), a.max(c).max(d)))
-            });
+            let extent = Aabb::from_points(tri_ids[range].iter().flat_map(|&t| *tris.get(t)));
             lb.slot[start] = lb.boxes.len() as u32;
             lb.boxes.push(extent.intersection(*cell).padded(super::KdTree::ROOT_PADDING));
         });

@@ -109,7 +109,7 @@ impl KdTree {
             params: *params,
             build_time: Duration::ZERO,
         };
-        tree.leaf_bounds = LeafBounds::new(tree.tri_ids.len(), &tree.tri_ids, &tree.tris, |f| {
+        tree.leaf_bounds = LeafBounds::new(&tree.tri_ids, &tree.tris, |f| {
             tree.visit(|_, cell, n| f(cell, n));
         });
         tree.build_time = start.elapsed();

@@ -62,11 +62,6 @@ impl BatchCull {
         BatchCull { origin, chunks }
     }
 
-    /// The common origin of the packets.
-    pub fn origin(&self) -> Vec3 {
-        self.origin
-    }
-
     /// Bits (lane `i` for packet `chunk * LANES + i`) of the packets of one chunk that may have a ray inside
     /// box `b` at a distance in `[tmin, limit]`, allowing the relative `slack` of the per-ray test; `limit`
     /// holds the packets' farthest current hits, padded to whole chunks.
