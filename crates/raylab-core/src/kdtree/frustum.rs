@@ -110,6 +110,7 @@ pub(super) fn leaf_intersect<V: Vf32>(
 }
 
 /// Any-hit counterpart of [`leaf_intersect`]: marks lanes blocked by the leaf's triangles in `blocked`.
+/// Returns how many packets of `set` this leaf finished (all their lanes blocked).
 #[inline(always)]
 pub(super) fn leaf_occlude<V: Vf32>(
     leaf: &Leaf,
@@ -118,13 +119,14 @@ pub(super) fn leaf_occlude<V: Vf32>(
     cull: bool,
     blocked: &mut [V::Mask],
     stats: &mut TraversalStats,
-) {
+) -> usize {
     let tree = leaf.tree;
     let ids = &tree.tri_ids()[leaf.node.leaf_range()];
     if ids.is_empty() {
-        return;
+        return 0;
     }
     let bounds = &tree.leaf_bounds(leaf.node);
+    let mut finished = 0;
     let mut batch = BatchBits::default();
     for &j in set {
         let p = &tile.packets[j];
@@ -152,7 +154,9 @@ pub(super) fn leaf_occlude<V: Vf32>(
                 break;
             }
         }
+        finished += (p.valid & !blocked[j]).none() as usize;
     }
+    finished
 }
 
 /// What a frustum walk does at a leaf. A trait rather than a closure so that it is always inlined into the
@@ -186,24 +190,22 @@ struct BlockedLeaves<'a, V: Vf32> {
     set: &'a [usize],
     cull: bool,
     blocked: &'a mut [V::Mask],
+    /// Packets of `set` with a lane not blocked yet.
+    open: usize,
 }
 
 impl<V: Vf32> FrustumLeaf for BlockedLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
-        leaf_occlude(leaf, self.tile, self.set, self.cull, self.blocked, stats);
-        (f32::INFINITY, open_lanes(self.tile, self.set, self.blocked) == 0)
+        self.open -= leaf_occlude(leaf, self.tile, self.set, self.cull, self.blocked, stats);
+        (f32::INFINITY, self.open == 0)
     }
 }
 
-/// The lanes (bits) of packets `set` that are not blocked yet.
+/// How many packets of `set` have a lane that is not blocked yet.
 #[inline(always)]
-pub(super) fn open_lanes<V: Vf32>(tile: &PacketTile<V>, set: &[usize], blocked: &[V::Mask]) -> u32 {
-    let mut open = 0;
-    for &j in set {
-        open |= (tile.packets[j].valid & !blocked[j]).bits();
-    }
-    open
+pub(super) fn open_packets<V: Vf32>(tile: &PacketTile<V>, set: &[usize], blocked: &[V::Mask]) -> usize {
+    set.iter().filter(|&&j| (tile.packets[j].valid & !blocked[j]).any()).count()
 }
 
 /// The largest current hit distance over the lanes of packets `set` (infinite while any lane has none).
@@ -239,7 +241,8 @@ impl KdTree {
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
-        self.traverse_frustum(f, stats, &mut BlockedLeaves { tile, set, cull, blocked });
+        let open = open_packets(tile, set, blocked);
+        self.traverse_frustum(f, stats, &mut BlockedLeaves { tile, set, cull, blocked, open });
     }
 
     /// Walks the leaves the frustum overlaps, roughly front to back, handing each to `leaf`.

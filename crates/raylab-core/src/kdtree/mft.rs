@@ -9,7 +9,7 @@
 
 use raylab_simd::{VMask, Vf32};
 
-use super::frustum::{Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude, open_lanes};
+use super::frustum::{Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude, open_packets};
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::coord;
@@ -118,6 +118,8 @@ struct BlockedLeaves<'a, V: Vf32> {
     sets: &'a [Vec<usize>; 4],
     cull: bool,
     blocked: &'a mut [V::Mask],
+    /// Per frustum, the packets with a lane not blocked yet.
+    open: [usize; 4],
     done: u32,
 }
 
@@ -127,8 +129,8 @@ impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
         for (i, set) in self.sets.iter().enumerate() {
             if active >> i & 1 == 1 {
                 let leaf = Leaf { near: near[i], ..*leaf };
-                leaf_occlude(&leaf, self.tile, set, self.cull, self.blocked, stats);
-                if open_lanes(self.tile, set, self.blocked) == 0 {
+                self.open[i] -= leaf_occlude(&leaf, self.tile, set, self.cull, self.blocked, stats);
+                if self.open[i] == 0 {
                     self.done |= 1 << i;
                 }
             }
@@ -173,7 +175,8 @@ impl KdTree {
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
-        self.traverse_mft(f, stats, &mut BlockedLeaves { tile, sets, cull, blocked, done: 0 });
+        let open = std::array::from_fn(|i| open_packets(tile, &sets[i], blocked));
+        self.traverse_mft(f, stats, &mut BlockedLeaves { tile, sets, cull, blocked, open, done: 0 });
     }
 
     /// Walks the leaves the four frustums overlap, handing each to `leaf`.
