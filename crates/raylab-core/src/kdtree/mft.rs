@@ -13,7 +13,7 @@ use super::frustum::{Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude,
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::coord;
-use crate::packet::{Bundle4, Frustum, MAX_LANES, PacketTile, bundle_lanes, map3};
+use crate::packet::{Bundle4, Frustum, MAX_LANES, PacketTile, bundle_lanes, map3, sign_crossing4};
 use crate::stats::TraversalStats;
 
 /// Four frustums with a common origin, one per SIMD lane.
@@ -72,15 +72,8 @@ impl<V: Vf32> Bundle4<V> for Frustum4<V> {
     }
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (V, V) {
-        let dist = split - coord(&self.origin, k);
-        let slack = self.origin_slack;
-        if dist > slack {
-            (V::splat(dist - slack) * self.pos_near[k], V::splat(dist + slack) * self.pos_far[k])
-        } else if dist < -slack {
-            (V::splat(dist + slack) * self.neg_near[k], V::splat(dist - slack) * self.neg_far[k])
-        } else {
-            (V::splat(0.0), V::splat(f32::INFINITY))
-        }
+        let factors = [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
+        sign_crossing4(split - coord(&self.origin, k), self.origin_slack, factors)
     }
 }
 

@@ -7,7 +7,11 @@
 //! plane `x_k = split` at a depth between `dist / (v_k + beta_k)` and `dist / (v_k - beta_k)`, where
 //! `dist = split - s_k` and `beta_k = tan(alpha) sqrt(1 - v_k^2)` (Eq. 4.8). The two reciprocals are
 //! precomputed per axis (Listing 4.4), so a split costs two multiplies; a negative depth means "never
-//! crosses in front" and becomes infinite (the omni-directional rule of 4.1.2).
+//! crosses in front" and becomes infinite (the omni-directional rule of 4.1.2). Which of the two is the
+//! near and which the far bound, and which becomes infinite, depends only on the signs of `dist` and of
+//! `v_k +- beta_k`, so the precomputation also sorts them into the four per-sign factors of a
+//! [`super::Frustum`]: a node then costs a cone what it costs a pyramid, one branch on the side of the
+//! plane and two multiplies, with the same bounds as Listing 4.3's sorted and corrected products.
 //!
 //! Depth is at most the distance along a unit direction, so comparing an entry's depth with the rays' hit
 //! distances stays conservative.
@@ -15,7 +19,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{Disc, RayPacket, bundle_lanes, map3, tile::Bundle, tile::Bundle4};
+use super::{Disc, RayPacket, bundle_lanes, map3, sign_crossing, sign_crossing4, tile::Bundle, tile::Bundle4};
 use crate::aabb::coord;
 
 /// A cone bounding a bundle of rays from one origin.
@@ -27,10 +31,16 @@ pub struct Cone {
     pub axis: Vec3,
     /// Tangent of the half-angle.
     pub tan_alpha: f32,
-    /// Per axis `1 / (v_k + beta_k)` (Listing 4.4's `precompute[0]`).
-    pub inv_hi: [f32; 3],
-    /// Per axis `1 / (v_k - beta_k)` (`precompute[1]`).
-    pub inv_lo: [f32; 3],
+    /// Per axis, for planes with `dist > 0`: the near factor `1 / (v_k + beta_k)` (Listing 4.4's
+    /// `precompute[0]`), +inf where no ray goes toward them.
+    pub pos_near: [f32; 3],
+    /// For `dist > 0`: the far factor `1 / (v_k - beta_k)` (`precompute[1]`), +inf where some ray runs
+    /// parallel to the axis or away from the plane.
+    pub pos_far: [f32; 3],
+    /// For `dist < 0`: the near factor `1 / (v_k - beta_k)`, -inf where no ray goes toward them.
+    pub neg_near: [f32; 3],
+    /// For `dist < 0`: the far factor `1 / (v_k + beta_k)`, -inf where some ray runs parallel or away.
+    pub neg_far: [f32; 3],
     /// Smallest start depth.
     pub t_min: f32,
     /// Largest end distance (a bound on depth).
@@ -75,16 +85,22 @@ impl Cone {
         Some(Self::with_axis(apex, disc.normal, pad_tan(tan), 0.0, span.depth))
     }
 
-    /// The cone about unit `axis` with the per-axis precomputation of Listing 4.4.
+    /// The cone about unit `axis` with the per-axis precomputation of Listing 4.4, sorted by sign.
     fn with_axis(origin: Vec3, axis: Vec3, tan_alpha: f32, t_min: f32, t_max: f32) -> Self {
         let beta = axis.to_array().map(|v| tan_alpha * (1.0 - v * v).max(0.0).sqrt());
         let v = axis.to_array();
+        // The rays' axis components range over [v - beta, v + beta] (in units of depth).
+        let (hi, lo): ([f32; 3], [f32; 3]) =
+            (std::array::from_fn(|k| v[k] + beta[k]), std::array::from_fn(|k| v[k] - beta[k]));
+        let (inf, ninf) = (f32::INFINITY, f32::NEG_INFINITY);
         Self {
             origin,
             axis,
             tan_alpha,
-            inv_hi: std::array::from_fn(|k| 1.0 / (v[k] + beta[k])),
-            inv_lo: std::array::from_fn(|k| 1.0 / (v[k] - beta[k])),
+            pos_near: std::array::from_fn(|k| if hi[k] > 0.0 { 1.0 / hi[k] } else { inf }),
+            pos_far: std::array::from_fn(|k| if lo[k] > 0.0 { 1.0 / lo[k] } else { inf }),
+            neg_near: std::array::from_fn(|k| if lo[k] < 0.0 { 1.0 / lo[k] } else { ninf }),
+            neg_far: std::array::from_fn(|k| if hi[k] < 0.0 { 1.0 / hi[k] } else { ninf }),
             t_min,
             t_max,
             origin_slack: 0.0,
@@ -121,24 +137,12 @@ impl Bundle for Cone {
         (self.t_min, self.t_max)
     }
 
-    /// Listing 4.3 with the omni-directional rule: the two edge depths, negative ones made infinite, sorted.
+    /// Listing 4.3 with the omni-directional rule: the two edge depths, negative ones made infinite, in
+    /// order; the per-sign factors hold them already sorted.
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
-        let dist = split - coord(&self.origin, k);
-        let slack = self.origin_slack;
-        if dist.abs() <= slack {
-            return (0.0, f32::INFINITY);
-        }
-        let fix = |t: f32| if t < 0.0 || t.is_nan() { f32::INFINITY } else { t };
-        if slack == 0.0 {
-            // Rays that start at the apex (shadow samples, camera tiles): Listing 4.3's two products.
-            let (a, b) = (fix(dist * self.inv_hi[k]), fix(dist * self.inv_lo[k]));
-            return (a.min(b), a.max(b));
-        }
-        let (near_d, far_d) = if dist > 0.0 { (dist - slack, dist + slack) } else { (dist + slack, dist - slack) };
-        let (a, b) = (fix(near_d * self.inv_hi[k]), fix(near_d * self.inv_lo[k]));
-        let (c, d) = (fix(far_d * self.inv_hi[k]), fix(far_d * self.inv_lo[k]));
-        (a.min(b).min(c.min(d)), a.max(b).max(c.max(d)))
+        let factors = [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
+        sign_crossing(split - coord(&self.origin, k), self.origin_slack, factors)
     }
 }
 
@@ -151,8 +155,10 @@ pub(super) fn pad_tan(tan: f64) -> f32 {
 #[derive(Clone, Copy, Debug)]
 pub struct Cone4<V: Vf32> {
     origin: Vec3,
-    inv_hi: [V; 3],
-    inv_lo: [V; 3],
+    pos_near: [V; 3],
+    pos_far: [V; 3],
+    neg_near: [V; 3],
+    neg_far: [V; 3],
     t_min: V,
     t_max: V,
     origin_slack: f32,
@@ -170,8 +176,10 @@ impl<V: Vf32> Cone4<V> {
         let valid = c.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
         Some(Self {
             origin,
-            inv_hi: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.inv_hi[k], 0.0)),
-            inv_lo: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.inv_lo[k], 0.0)),
+            pos_near: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.pos_near[k], f32::INFINITY)),
+            pos_far: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.pos_far[k], f32::INFINITY)),
+            neg_near: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.neg_near[k], f32::NEG_INFINITY)),
+            neg_far: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.neg_far[k], f32::NEG_INFINITY)),
             t_min: lanes(&|x| x.t_min, f32::INFINITY),
             t_max: lanes(&|x| x.t_max, f32::NEG_INFINITY),
             origin_slack: c.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack)),
@@ -195,19 +203,8 @@ impl<V: Vf32> Bundle4<V> for Cone4<V> {
     }
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (V, V) {
-        let dist = split - coord(&self.origin, k);
-        let slack = self.origin_slack;
-        if dist.abs() <= slack {
-            return (V::splat(0.0), V::splat(f32::INFINITY));
-        }
-        let (near_d, far_d) = if dist > 0.0 { (dist - slack, dist + slack) } else { (dist + slack, dist - slack) };
-        let inf = V::splat(f32::INFINITY);
-        let zero = V::splat(0.0);
-        // Negative (or NaN) depths never come: make them infinite, as in Listing 4.5.
-        let fix = |t: V| V::select(t.ge(zero), t, inf);
-        let (a, b) = (fix(V::splat(near_d) * self.inv_hi[k]), fix(V::splat(near_d) * self.inv_lo[k]));
-        let (c, d) = (fix(V::splat(far_d) * self.inv_hi[k]), fix(V::splat(far_d) * self.inv_lo[k]));
-        (a.min(b).min(c.min(d)), a.max(b).max(c.max(d)))
+        let factors = [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
+        sign_crossing4(split - coord(&self.origin, k), self.origin_slack, factors)
     }
 }
 
@@ -243,5 +240,28 @@ mod tests {
             }
         }
         assert!(Cone::bounding(o, [(Vec3::X, 0.0, 1.0), (Vec3::NEG_X, 0.0, 1.0)].into_iter()).is_none());
+    }
+
+    /// The per-sign factors give exactly Listing 4.3's bounds: both edge depths `dist / (v_k +- beta_k)`,
+    /// negative ones made infinite, sorted; on axes the cone straddles, runs along, or faces either way.
+    #[test]
+    fn sign_factors_reproduce_listing_4_3() {
+        let axes = [Vec3::new(0.3, -0.8, 0.5), Vec3::X, Vec3::new(0.0, 0.6, -0.8), Vec3::new(-0.02, 1.0, 0.01)];
+        for axis in axes.map(|a| a.normalize()) {
+            for tan in [0.0f32, 0.01, 0.3, 2.0] {
+                let c = Cone::with_axis(Vec3::new(1.0, -2.0, 0.5), axis, tan, 0.0, 100.0);
+                for k in 0..3 {
+                    let v = axis[k];
+                    let beta = tan * (1.0 - v * v).max(0.0).sqrt();
+                    for split in [-7.0f32, -2.5, -2.0, 0.0, 0.5, 1.0, 3.0] {
+                        let dist = split - c.origin[k];
+                        let fix = |t: f32| if t < 0.0 || t.is_nan() { f32::INFINITY } else { t };
+                        let (a, b) = (fix(dist * (1.0 / (v + beta))), fix(dist * (1.0 / (v - beta))));
+                        let want = if dist == 0.0 { (0.0, f32::INFINITY) } else { (a.min(b), a.max(b)) };
+                        assert_eq!(c.crossing(k, split), want, "axis {axis} tan {tan} k {k} split {split}");
+                    }
+                }
+            }
+        }
     }
 }

@@ -332,15 +332,34 @@ impl Frustum {
     /// mean "some ray never crosses in front of the origin".
     #[inline(always)]
     pub fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
-        let dist = split - coord(&self.origin, k);
-        let slack = self.origin_slack;
-        if dist > slack {
-            ((dist - slack) * self.pos_near[k], (dist + slack) * self.pos_far[k])
-        } else if dist < -slack {
-            ((dist + slack) * self.neg_near[k], (dist - slack) * self.neg_far[k])
-        } else {
-            (0.0, f32::INFINITY)
-        }
+        let factors = [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
+        sign_crossing(split - coord(&self.origin, k), self.origin_slack, factors)
+    }
+}
+
+/// The range of distances at which a bundle crosses a plane at signed distance `dist` from its origin, from
+/// its axis's four factors `[pos_near, pos_far, neg_near, neg_far]` (see [`Frustum`]); a plane within `slack`
+/// of the origin may be crossed at any distance, and the bounds widen by it.
+#[inline(always)]
+pub(crate) fn sign_crossing(dist: f32, slack: f32, [pos_near, pos_far, neg_near, neg_far]: [f32; 4]) -> (f32, f32) {
+    if dist > slack {
+        ((dist - slack) * pos_near, (dist + slack) * pos_far)
+    } else if dist < -slack {
+        ((dist + slack) * neg_near, (dist - slack) * neg_far)
+    } else {
+        (0.0, f32::INFINITY)
+    }
+}
+
+/// [`sign_crossing`] for one bundle per lane (Multiple Frustum Traversal), all with the same origin.
+#[inline(always)]
+pub(crate) fn sign_crossing4<V: Vf32>(dist: f32, slack: f32, [pos_near, pos_far, neg_near, neg_far]: [V; 4]) -> (V, V) {
+    if dist > slack {
+        (V::splat(dist - slack) * pos_near, V::splat(dist + slack) * pos_far)
+    } else if dist < -slack {
+        (V::splat(dist + slack) * neg_near, V::splat(dist - slack) * neg_far)
+    } else {
+        (V::splat(0.0), V::splat(f32::INFINITY))
     }
 }
 
