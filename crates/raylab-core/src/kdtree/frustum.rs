@@ -205,7 +205,13 @@ impl<V: Vf32> FrustumLeaf for BlockedLeaves<'_, V> {
 /// How many packets of `set` have a lane that is not blocked yet.
 #[inline(always)]
 pub(super) fn open_packets<V: Vf32>(tile: &PacketTile<V>, set: &[usize], blocked: &[V::Mask]) -> usize {
-    set.iter().filter(|&&j| (tile.packets[j].valid & !blocked[j]).any()).count()
+    // A plain loop: an iterator adapter may stay out of line, compiled without the kernel's instruction set
+    // (see `crate::packet::map3`).
+    let mut open = 0;
+    for &j in set {
+        open += (tile.packets[j].valid & !blocked[j]).any() as usize;
+    }
+    open
 }
 
 /// The largest current hit distance over the lanes of packets `set` (infinite while any lane has none).
