@@ -40,37 +40,48 @@ pub(super) struct Leaf<'a> {
     pub near: f32,
 }
 
-/// The batched culling verdicts ([`crate::packet::BatchCull`]) of the last chunk of packets a leaf loop
-/// asked about, so a loop over packets in index order tests each chunk once.
-#[derive(Default)]
-struct BatchBits {
-    chunk: Option<usize>,
-    bits: u32,
+/// The batched culling verdicts ([`crate::packet::BatchCull`]) of one leaf for the last `SLOTS` chunks of
+/// packets asked about, in a direct-mapped cache: a loop over packets in index order tests each chunk once
+/// with one slot, and MFT's four quadrants, whose packets take turns in the same chunks (a quadrant of a
+/// 16x16 tile spans two chunks of eight 4x2 packets, shared with the quadrant beside it), need four. Verdicts
+/// stay valid while the leaf's packets find hits: a closer hit only makes a verdict more permissive than it
+/// needs to be.
+pub(super) struct BatchBits<const SLOTS: usize> {
+    chunk: [usize; SLOTS],
+    bits: [u32; SLOTS],
 }
 
-impl BatchBits {
+impl<const SLOTS: usize> Default for BatchBits<SLOTS> {
+    fn default() -> Self {
+        Self { chunk: [usize::MAX; SLOTS], bits: [0; SLOTS] }
+    }
+}
+
+impl<const SLOTS: usize> BatchBits<SLOTS> {
     /// False when packet `j` of `tile` certainly has no ray inside `bounds` before its current hits; true
     /// when it may, or when the tile has no batch data.
     #[inline(always)]
     fn may_enter<V: Vf32>(&mut self, tile: &PacketTile<V>, j: usize, bounds: &Aabb) -> bool {
         let Some(batch) = &tile.batch else { return true };
         let chunk = j / V::LANES;
-        if self.chunk != Some(chunk) {
-            self.chunk = Some(chunk);
-            self.bits = batch.maybe_inside::<V>(chunk, bounds, &tile.farthest_hit, SPLIT_SLACK);
+        let slot = chunk % SLOTS;
+        if self.chunk[slot] != chunk {
+            self.chunk[slot] = chunk;
+            self.bits[slot] = batch.maybe_inside::<V>(chunk, bounds, &tile.farthest_hit, SPLIT_SLACK);
         }
-        self.bits >> (j % V::LANES) & 1 == 1
+        self.bits[slot] >> (j % V::LANES) & 1 == 1
     }
 }
 
-/// Tests `leaf` against packets `set` of `tile`, culling packets whose rays miss its box when `cull` is on.
-/// Returns true when some lane's closest hit changed.
+/// Tests `leaf` against packets `set` of `tile`, culling packets whose rays miss its box when `cull` is on
+/// (`batch` holds this leaf's batched verdicts). Returns true when some lane's closest hit changed.
 #[inline(always)]
-pub(super) fn leaf_intersect<V: Vf32>(
+pub(super) fn leaf_intersect<V: Vf32, const SLOTS: usize>(
     leaf: &Leaf,
     tile: &mut PacketTile<V>,
     set: &[usize],
     cull: bool,
+    batch: &mut BatchBits<SLOTS>,
     stats: &mut TraversalStats,
 ) -> bool {
     let tree = leaf.tree;
@@ -81,7 +92,6 @@ pub(super) fn leaf_intersect<V: Vf32>(
     let bounds = &tree.leaf_bounds(leaf.node);
     let mut changed = false;
     let done_before = leaf.near * (1.0 - SPLIT_SLACK);
-    let mut batch = BatchBits::default();
     for &j in set {
         // A packet whose rays all hit before the leaf starts: nothing here can be closer.
         if tile.farthest_hit[j] < done_before || (cull && !batch.may_enter(tile, j, bounds)) {
@@ -112,11 +122,12 @@ pub(super) fn leaf_intersect<V: Vf32>(
 /// Any-hit counterpart of [`leaf_intersect`]: marks lanes blocked by the leaf's triangles in `blocked`.
 /// Returns how many packets of `set` this leaf finished (all their lanes blocked).
 #[inline(always)]
-pub(super) fn leaf_occlude<V: Vf32>(
+pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
     leaf: &Leaf,
     tile: &PacketTile<V>,
     set: &[usize],
     cull: bool,
+    batch: &mut BatchBits<SLOTS>,
     blocked: &mut [V::Mask],
     stats: &mut TraversalStats,
 ) -> usize {
@@ -127,7 +138,6 @@ pub(super) fn leaf_occlude<V: Vf32>(
     }
     let bounds = &tree.leaf_bounds(leaf.node);
     let mut finished = 0;
-    let mut batch = BatchBits::default();
     for &j in set {
         let p = &tile.packets[j];
         let mut open = p.valid & !blocked[j];
@@ -177,7 +187,7 @@ struct ClosestLeaves<'a, V: Vf32> {
 impl<V: Vf32> FrustumLeaf for ClosestLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
-        if leaf_intersect(leaf, self.tile, self.set, self.cull, stats) {
+        if leaf_intersect(leaf, self.tile, self.set, self.cull, &mut BatchBits::<1>::default(), stats) {
             self.limit = hit_limit(self.tile, self.set);
         }
         (self.limit, false)
@@ -197,7 +207,8 @@ struct BlockedLeaves<'a, V: Vf32> {
 impl<V: Vf32> FrustumLeaf for BlockedLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
-        self.open -= leaf_occlude(leaf, self.tile, self.set, self.cull, self.blocked, stats);
+        let batch = &mut BatchBits::<1>::default();
+        self.open -= leaf_occlude(leaf, self.tile, self.set, self.cull, batch, self.blocked, stats);
         (f32::INFINITY, self.open == 0)
     }
 }

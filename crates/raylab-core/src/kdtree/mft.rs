@@ -9,7 +9,7 @@
 
 use raylab_simd::{VMask, Vf32};
 
-use super::frustum::{Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude, open_packets};
+use super::frustum::{BatchBits, Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude, open_packets};
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::coord;
@@ -95,9 +95,11 @@ struct ClosestLeaves<'a, V: Vf32> {
 impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32) {
+        // One set of batched verdicts for the four frustums: their packets share chunks.
+        let batch = &mut BatchBits::<4>::default();
         for (i, set) in self.sets.iter().enumerate() {
             let leaf = Leaf { near: near[i], ..*leaf };
-            if active >> i & 1 == 1 && leaf_intersect(&leaf, self.tile, set, self.cull, stats) {
+            if active >> i & 1 == 1 && leaf_intersect(&leaf, self.tile, set, self.cull, batch, stats) {
                 self.limit[i] = hit_limit(self.tile, set);
             }
         }
@@ -119,10 +121,11 @@ struct BlockedLeaves<'a, V: Vf32> {
 impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32) {
+        let batch = &mut BatchBits::<4>::default();
         for (i, set) in self.sets.iter().enumerate() {
             if active >> i & 1 == 1 {
                 let leaf = Leaf { near: near[i], ..*leaf };
-                self.open[i] -= leaf_occlude(&leaf, self.tile, set, self.cull, self.blocked, stats);
+                self.open[i] -= leaf_occlude(&leaf, self.tile, set, self.cull, batch, self.blocked, stats);
                 if self.open[i] == 0 {
                     self.done |= 1 << i;
                 }
