@@ -13,10 +13,11 @@ use super::frustum::{BatchBits, Leaf, front_child, hit_limit, leaf_intersect, le
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::coord;
-use crate::packet::{Bundle4, Frustum, MAX_LANES, PacketTile, bundle_lanes, map3, sign_crossing4};
+use crate::packet::{Bundle, Bundle4, MAX_LANES, PacketTile, bundle_lanes, map3, sign_crossing4};
 use crate::stats::TraversalStats;
 
-/// Four frustums with a common origin, one per SIMD lane.
+/// Four bundles (pyramid frustums or cones) with a common origin, one per SIMD lane, each through its
+/// per-sign crossing factors.
 #[derive(Clone, Copy, Debug)]
 pub struct Frustum4<V: Vf32> {
     origin: glam::Vec3,
@@ -27,31 +28,29 @@ pub struct Frustum4<V: Vf32> {
     t_min: V,
     t_max: V,
     origin_slack: f32,
-    /// Lanes that hold a frustum.
+    /// Lanes that hold a bundle.
     valid: V::Mask,
 }
 
 impl<V: Vf32> Frustum4<V> {
-    /// Packs up to four frustums with the same origin; `None` entries leave a lane empty.
+    /// Packs up to four bundles with the same origin; `None` entries leave a lane empty.
     #[inline(always)]
-    pub fn new(f: [Option<Frustum>; 4]) -> Option<Self> {
-        assert!(V::LANES >= 4, "MFT traces four frustums");
-        let first = f.iter().flatten().next()?;
-        let origin = first.origin;
-        assert!(f.iter().flatten().all(|x| x.origin == origin), "MFT frustums share their origin");
-        let lanes = |g: &dyn Fn(&Frustum) -> f32, empty: f32| bundle_lanes::<V, _>(&f, g, empty);
-        let axes =
-            |g: &dyn Fn(&Frustum, usize) -> f32, empty: f32| map3([0, 1, 2], |k| lanes(&|x: &Frustum| g(x, k), empty));
+    pub fn new<B: Bundle>(f: [Option<B>; 4]) -> Option<Self> {
+        assert!(V::LANES >= 4, "MFT traces four bundles");
+        let origin = f.iter().flatten().next()?.origin();
+        assert!(f.iter().flatten().all(|x| x.origin() == origin), "MFT bundles share their origin");
+        let lanes = |g: &dyn Fn(&B) -> f32, empty: f32| bundle_lanes::<V, _>(&f, g, empty);
+        let factor = |i: usize, empty: f32| map3([0, 1, 2], |k| lanes(&|x: &B| x.factors(k)[i], empty));
         let valid = f.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
         Some(Self {
             origin,
-            pos_near: axes(&|x, k| x.pos_near[k], f32::INFINITY),
-            pos_far: axes(&|x, k| x.pos_far[k], f32::INFINITY),
-            neg_near: axes(&|x, k| x.neg_near[k], f32::NEG_INFINITY),
-            neg_far: axes(&|x, k| x.neg_far[k], f32::NEG_INFINITY),
-            t_min: lanes(&|x| x.t_min, f32::INFINITY),
-            t_max: lanes(&|x| x.t_max, f32::NEG_INFINITY),
-            origin_slack: f.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack)),
+            pos_near: factor(0, f32::INFINITY),
+            pos_far: factor(1, f32::INFINITY),
+            neg_near: factor(2, f32::NEG_INFINITY),
+            neg_far: factor(3, f32::NEG_INFINITY),
+            t_min: lanes(&|x| x.t_range().0, f32::INFINITY),
+            t_max: lanes(&|x| x.t_range().1, f32::NEG_INFINITY),
+            origin_slack: f.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack())),
             valid: V::Mask::from_bits(valid),
         })
     }

@@ -19,8 +19,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{Disc, RayPacket, bundle_lanes, map3, sign_crossing, sign_crossing4, tile::Bundle, tile::Bundle4};
-use crate::aabb::coord;
+use super::{Disc, RayPacket, tile::Bundle};
 
 /// A cone bounding a bundle of rays from one origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -137,75 +136,22 @@ impl Bundle for Cone {
         (self.t_min, self.t_max)
     }
 
+    #[inline(always)]
+    fn origin_slack(&self) -> f32 {
+        self.origin_slack
+    }
+
     /// Listing 4.3 with the omni-directional rule: the two edge depths, negative ones made infinite, in
     /// order; the per-sign factors hold them already sorted.
     #[inline(always)]
-    fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
-        let factors = [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
-        sign_crossing(split - coord(&self.origin, k), self.origin_slack, factors)
+    fn factors(&self, k: usize) -> [f32; 4] {
+        [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]]
     }
 }
 
 /// A half-angle tangent widened for the rounding of unit directions and of the f32 products of a walk.
 pub(super) fn pad_tan(tan: f64) -> f32 {
     (tan * (1.0 + 1e-4) + 1e-5) as f32
-}
-
-/// Four cones with one apex, one per SIMD lane (MFT over cones, thesis 4.1.9).
-#[derive(Clone, Copy, Debug)]
-pub struct Cone4<V: Vf32> {
-    origin: Vec3,
-    pos_near: [V; 3],
-    pos_far: [V; 3],
-    neg_near: [V; 3],
-    neg_far: [V; 3],
-    t_min: V,
-    t_max: V,
-    origin_slack: f32,
-    valid: V::Mask,
-}
-
-impl<V: Vf32> Cone4<V> {
-    /// Packs up to four cones with the same apex; `None` entries leave a lane empty.
-    #[inline(always)]
-    pub fn new(c: [Option<Cone>; 4]) -> Option<Self> {
-        assert!(V::LANES >= 4, "MFT traces four cones");
-        let origin = c.iter().flatten().next()?.origin;
-        assert!(c.iter().flatten().all(|x| x.origin == origin), "MFT cones share their apex");
-        let lanes = |g: &dyn Fn(&Cone) -> f32, empty: f32| bundle_lanes::<V, _>(&c, g, empty);
-        let valid = c.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
-        Some(Self {
-            origin,
-            pos_near: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.pos_near[k], f32::INFINITY)),
-            pos_far: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.pos_far[k], f32::INFINITY)),
-            neg_near: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.neg_near[k], f32::NEG_INFINITY)),
-            neg_far: map3([0, 1, 2], |k| lanes(&|x: &Cone| x.neg_far[k], f32::NEG_INFINITY)),
-            t_min: lanes(&|x| x.t_min, f32::INFINITY),
-            t_max: lanes(&|x| x.t_max, f32::NEG_INFINITY),
-            origin_slack: c.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack)),
-            valid: V::Mask::from_bits(valid),
-        })
-    }
-}
-
-impl<V: Vf32> Bundle4<V> for Cone4<V> {
-    #[inline(always)]
-    fn origin(&self) -> Vec3 {
-        self.origin
-    }
-    #[inline(always)]
-    fn t_range(&self) -> (V, V) {
-        (self.t_min, self.t_max)
-    }
-    #[inline(always)]
-    fn valid(&self) -> V::Mask {
-        self.valid
-    }
-    #[inline(always)]
-    fn crossing(&self, k: usize, split: f32) -> (V, V) {
-        let factors = [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
-        sign_crossing4(split - coord(&self.origin, k), self.origin_slack, factors)
-    }
 }
 
 #[cfg(test)]

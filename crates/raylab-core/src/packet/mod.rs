@@ -13,10 +13,10 @@ use raylab_simd::{VMask, Vf32};
 use crate::ray::{Hit, Ray};
 
 pub use batch_cull::BatchCull;
-pub use cone::{Cone, Cone4};
+pub use cone::Cone;
 pub use disc::Disc;
+pub(crate) use tile::sign_crossing4;
 pub use tile::{Bundle, Bundle4, Frustum, PacketTile, overlaps_box, slab_interval};
-pub(crate) use tile::{sign_crossing, sign_crossing4};
 pub(crate) use woop::{crossing_packet, sheared_test};
 pub use woop::{intersect_packet, occlude_packet};
 

@@ -137,15 +137,24 @@ pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -
 }
 
 /// A bundle of rays from one origin, seen by the frustum walks only through the range of distances at which
-/// its rays cross an axis-aligned plane: pyramid [`Frustum`]s and [`super::Cone`]s implement it.
+/// its rays cross an axis-aligned plane, which four factors per axis give by the side of the origin the plane
+/// lies on ([`sign_crossing`]): pyramid [`Frustum`]s and [`super::Cone`]s implement it.
 pub trait Bundle {
     /// The common origin.
     fn origin(&self) -> Vec3;
     /// The range of distances the walk starts with.
     fn t_range(&self) -> (f32, f32);
+    /// Distance by which the bundle's segments may miss its origin (see [`Frustum::origin_slack`]).
+    fn origin_slack(&self) -> f32;
+    /// Axis `k`'s factors `[pos_near, pos_far, neg_near, neg_far]` (see [`Frustum`]).
+    fn factors(&self, k: usize) -> [f32; 4];
+
     /// The range of distances at which the bundle crosses the plane `coordinate k = split`; infinite bounds
     /// mean "some ray never crosses in front of the origin".
-    fn crossing(&self, k: usize, split: f32) -> (f32, f32);
+    #[inline(always)]
+    fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
+        sign_crossing(split - coord(&self.origin(), k), self.origin_slack(), self.factors(k))
+    }
 }
 
 /// Four bundles with one common origin, one per SIMD lane, for Multiple Frustum Traversal.
@@ -161,15 +170,21 @@ pub trait Bundle4<V: Vf32> {
 }
 
 impl Bundle for Frustum {
+    #[inline(always)]
     fn origin(&self) -> Vec3 {
         self.origin
     }
+    #[inline(always)]
     fn t_range(&self) -> (f32, f32) {
         (self.t_min, self.t_max)
     }
     #[inline(always)]
-    fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
-        Frustum::crossing(self, k, split)
+    fn origin_slack(&self) -> f32 {
+        self.origin_slack
+    }
+    #[inline(always)]
+    fn factors(&self, k: usize) -> [f32; 4] {
+        [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]]
     }
 }
 
@@ -327,21 +342,13 @@ impl Frustum {
         }
         Some(f)
     }
-
-    /// The range of distances at which the bundle crosses the plane `coordinate k = split`; infinite bounds
-    /// mean "some ray never crosses in front of the origin".
-    #[inline(always)]
-    pub fn crossing(&self, k: usize, split: f32) -> (f32, f32) {
-        let factors = [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
-        sign_crossing(split - coord(&self.origin, k), self.origin_slack, factors)
-    }
 }
 
 /// The range of distances at which a bundle crosses a plane at signed distance `dist` from its origin, from
 /// its axis's four factors `[pos_near, pos_far, neg_near, neg_far]` (see [`Frustum`]); a plane within `slack`
 /// of the origin may be crossed at any distance, and the bounds widen by it.
 #[inline(always)]
-pub(crate) fn sign_crossing(dist: f32, slack: f32, [pos_near, pos_far, neg_near, neg_far]: [f32; 4]) -> (f32, f32) {
+fn sign_crossing(dist: f32, slack: f32, [pos_near, pos_far, neg_near, neg_far]: [f32; 4]) -> (f32, f32) {
     if dist > slack {
         ((dist - slack) * pos_near, (dist + slack) * pos_far)
     } else if dist < -slack {

@@ -21,7 +21,7 @@ use crate::kdtree::mft::Frustum4;
 use crate::kdtree::packet::PacketStack;
 use crate::mbvh::Mbvh;
 use crate::method::Method;
-use crate::packet::{Cone, Cone4};
+use crate::packet::Cone;
 use crate::packet::{Frustum, PacketTile, RayPacket, map3};
 use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
@@ -355,7 +355,7 @@ impl<'a> Tracer<'a> {
             }
             Method::MftCone => {
                 let quads = self.quadrants(&tile, rays, None, common_origin_cone, toward_cone);
-                let c4 = quads.and_then(|(b, sets, _)| Some((Cone4::new(b)?, sets)));
+                let c4 = quads.and_then(|(b, sets, _)| Some((Frustum4::new(b)?, sets)));
                 if let Some((c4, sets)) = &c4 {
                     self.tree.intersect_mft(c4, &mut tile, sets, cull, stats);
                 }
@@ -434,7 +434,7 @@ impl<'a> Tracer<'a> {
             },
             Method::MftCone => match self.quadrants(&tile, rays, toward, common_origin_cone, toward_cone) {
                 Some((b, sets, rest)) => {
-                    if let Some(c4) = Cone4::new(b) {
+                    if let Some(c4) = Frustum4::new(b) {
                         self.tree.occluded_mft(&c4, &tile, &sets, self.options.cull, &mut blocked, stats);
                     }
                     leftover = Some(rest);
