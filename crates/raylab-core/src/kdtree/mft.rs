@@ -40,14 +40,14 @@ impl<V: Vf32> Frustum4<V> {
         let origin = f.iter().flatten().next()?.origin();
         assert!(f.iter().flatten().all(|x| x.origin() == origin), "MFT bundles share their origin");
         let lanes = |g: &dyn Fn(&B) -> f32, empty: f32| bundle_lanes::<V, _>(&f, g, empty);
-        let factor = |i: usize, empty: f32| map3([0, 1, 2], |k| lanes(&|x: &B| x.factors(k)[i], empty));
+        let axes = |g: &dyn Fn(&B, usize) -> f32, empty: f32| map3([0, 1, 2], |k| lanes(&|x: &B| g(x, k), empty));
         let valid = f.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
         Some(Self {
             origin,
-            pos_near: factor(0, f32::INFINITY),
-            pos_far: factor(1, f32::INFINITY),
-            neg_near: factor(2, f32::NEG_INFINITY),
-            neg_far: factor(3, f32::NEG_INFINITY),
+            pos_near: axes(&|x, k| x.factors(k)[0], f32::INFINITY),
+            pos_far: axes(&|x, k| x.factors(k)[1], f32::INFINITY),
+            neg_near: axes(&|x, k| x.factors(k)[2], f32::NEG_INFINITY),
+            neg_far: axes(&|x, k| x.factors(k)[3], f32::NEG_INFINITY),
             t_min: lanes(&|x| x.t_range().0, f32::INFINITY),
             t_max: lanes(&|x| x.t_range().1, f32::NEG_INFINITY),
             origin_slack: f.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack())),
@@ -170,7 +170,13 @@ impl KdTree {
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
-        let open = std::array::from_fn(|i| open_packets(tile, &sets[i], blocked));
+        // Written out rather than with `array::from_fn`, which may stay out of line (see `map3`).
+        let open = [
+            open_packets(tile, &sets[0], blocked),
+            open_packets(tile, &sets[1], blocked),
+            open_packets(tile, &sets[2], blocked),
+            open_packets(tile, &sets[3], blocked),
+        ];
         self.traverse_mft(f, stats, &mut BlockedLeaves { tile, sets, cull, blocked, open, done: 0 });
     }
 
