@@ -8,8 +8,6 @@
 //! costs tens of milliseconds of CPU per draw of a 1280x720 window with the panel, time taken from the tracer
 //! on the same cores.
 
-use std::time::{Duration, Instant};
-
 use crate::gpu::Gpu;
 
 /// Format of the frame texture: display-ready 8-bit values.
@@ -209,18 +207,10 @@ impl Compositor {
         }
     }
 
-    /// Uploads a traced frame of `width x height` RGBA8 pixels; returns the time the CPU spent on it.
-    pub fn upload(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        width: u32,
-        height: u32,
-        rgba: &[[u8; 4]],
-    ) -> Duration {
-        let t0 = Instant::now();
+    /// Uploads a traced frame of `width x height` RGBA8 pixels.
+    pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, width: u32, height: u32, rgba: &[[u8; 4]]) {
         if rgba.len() != (width as usize) * (height as usize) || width == 0 || height == 0 {
-            return t0.elapsed();
+            return;
         }
         self.ensure_frame(device, (width, height));
         if let Some(f) = &self.frame {
@@ -237,7 +227,6 @@ impl Compositor {
                 wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
             );
         }
-        t0.elapsed()
     }
 
     /// The frame texture as a render target of `size` pixels (made or resized as needed): the hybrid mode's

@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use crate::capture::capture;
 use crate::compositor::Compositor;
+use crate::cpu_clock::{Cost, Stamp};
 use crate::gpu::Gpu;
 use crate::hybrid::HybridGpu;
 use crate::lab::{Lab, StatsReport};
@@ -35,11 +36,11 @@ pub struct UiFrame {
     pub platform: egui::PlatformOutput,
     /// When egui wants the next frame (`Duration::ZERO`: at once; `Duration::MAX`: only on input).
     pub repaint_delay: Duration,
-    /// CPU time of the frame upload, when a new traced frame was uploaded.
-    pub upload_ms: Option<f64>,
-    /// CPU milliseconds spent on this UI frame so far: running egui, tessellating, encoding and submitting
-    /// (not the upload, and not waiting for the window's next image).
-    cpu_ms: f64,
+    /// Cost of the frame upload, when a new traced frame was uploaded.
+    pub upload: Option<Cost>,
+    /// Cost of this UI frame so far: running egui, tessellating, encoding and submitting (not the upload, and
+    /// not waiting for the window's next image).
+    cost: Cost,
 }
 
 impl Frontend {
@@ -51,6 +52,7 @@ impl Frontend {
 
     /// Advances `lab`, uploads its newest traced frame and runs the UI for a target of `size` pixels.
     pub fn build(&mut self, lab: &mut Lab, raw: egui::RawInput, size: (u32, u32), ppp: f32) -> UiFrame {
+        let stamp = Stamp::now();
         let started = Instant::now();
         let dt = started.duration_since(self.last_tick).as_secs_f32();
         self.last_tick = started;
@@ -69,20 +71,22 @@ impl Frontend {
             h.step(&self.gpu, lab);
         }
         let fresh = lab.poll().map(|r| (r.hybrid.clone(), r.frame.width, r.frame.height));
-        let upload_ms = match fresh {
+        let upload = match fresh {
             Some((Some(h), _, _)) => {
+                let s = Stamp::now();
                 let shown = self.hybrid.as_mut().and_then(|g| g.show(&self.gpu, &mut self.compositor, &h, lab));
                 lab.hybrid_gpu_ms = shown;
                 if let Some((upload, composite)) = shown {
                     lab.readouts.push_hybrid_gpu(upload, composite);
                 }
-                shown.map(|(upload, composite)| upload + composite)
+                shown.map(|_| s.cost())
             }
             Some((None, w, h)) => {
                 let f = lab.latest().map(|r| &r.frame).filter(|f| (f.width, f.height) == (w, h));
                 f.map(|f| {
-                    let d = self.compositor.upload(&self.gpu.device, &self.gpu.queue, f.width, f.height, &f.rgba);
-                    d.as_secs_f64() * 1e3
+                    let s = Stamp::now();
+                    self.compositor.upload(&self.gpu.device, &self.gpu.queue, f.width, f.height, &f.rgba);
+                    s.cost()
                 })
             }
             None => None,
@@ -97,20 +101,20 @@ impl Frontend {
             free,
             platform: out.platform_output,
             repaint_delay,
-            upload_ms,
-            cpu_ms: started.elapsed().as_secs_f64() * 1e3 - upload_ms.unwrap_or(0.0),
+            upload,
+            cost: stamp.cost().minus(upload.unwrap_or_default()),
         }
     }
 
     /// Draws `frame` into `target` (of `size` pixels) and submits it.
     pub fn draw(&mut self, frame: &mut UiFrame, target: &wgpu::TextureView, size: (u32, u32)) {
-        let t0 = Instant::now();
+        let stamp = Stamp::now();
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ui") });
         let extra = self.compositor.prepare_egui(device, queue, &mut encoder, &frame.jobs, &frame.screen);
         self.compositor.draw(&self.gpu, &mut encoder, target, size, &frame.jobs, &frame.screen);
         queue.submit(extra.into_iter().chain([encoder.finish()]));
-        frame.cpu_ms += t0.elapsed().as_secs_f64() * 1e3;
+        frame.cost = frame.cost.plus(stamp.cost());
     }
 
     /// Saves the window shots `lab` asked for, then lets egui free what it no longer needs, and records the
@@ -123,7 +127,7 @@ impl Frontend {
             }
         }
         self.compositor.free_egui(&frame.free);
-        lab.readouts.push_ui(frame.upload_ms, frame.cpu_ms);
+        lab.readouts.push_ui(frame.upload, frame.cost);
     }
 
     /// Draws `frame` offscreen and writes it as PNG.
@@ -187,7 +191,7 @@ struct HybridStats {
 impl Automation {
     /// True once enough frames were traced and the last one is on screen (it was uploaded by `frame`).
     pub fn due(&self, lab: &Lab, frame: &UiFrame) -> bool {
-        lab.readouts.frames() as u64 >= self.frames && frame.upload_ms.is_some()
+        lab.readouts.frames() as u64 >= self.frames && frame.upload.is_some()
     }
 
     /// Writes the requested outputs from `frame`; the error names the file.

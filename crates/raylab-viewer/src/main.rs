@@ -11,6 +11,7 @@ mod capture;
 mod cli;
 mod compare;
 mod compositor;
+mod cpu_clock;
 mod fly;
 mod frontend;
 mod gpu;

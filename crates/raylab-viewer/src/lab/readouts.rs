@@ -9,6 +9,7 @@ use raylab_core::render::{FrameView, StageTimes, depth_grey, heat_color};
 use raylab_core::stats::TraversalStats;
 use serde::Serialize;
 
+use crate::cpu_clock::Cost;
 use crate::worker::Rendered;
 
 /// Seconds of history the plots show.
@@ -35,8 +36,8 @@ struct Shown {
     last: Option<(TraversalStats, StageTimes, f64)>,
     /// The corner's lines about the latest traced frame: wall seconds and what traced it.
     corner: Option<(f64, String)>,
-    upload_ms: f64,
-    ui_ms: f64,
+    upload: Cost,
+    ui: Cost,
     ui_fps: usize,
     /// The newest plotted sample's time: the plots end there.
     until_t: f64,
@@ -52,8 +53,8 @@ pub struct Readouts {
     totals: TraversalStats,
     stages: StageTimes,
     last: Option<(TraversalStats, StageTimes, f64)>,
-    upload_ms: Vec<f64>,
-    ui_ms: Vec<f64>,
+    upload: Vec<Cost>,
+    ui: Vec<Cost>,
     ui_frames: VecDeque<Instant>,
     /// Hybrid mode, per frame: raster, readback and trace ms, and when the frame arrived.
     hybrid_cpu: Vec<([f64; 3], Instant)>,
@@ -86,8 +87,8 @@ impl Default for Readouts {
             totals: TraversalStats::default(),
             stages: StageTimes::default(),
             last: None,
-            upload_ms: Vec::new(),
-            ui_ms: Vec::new(),
+            upload: Vec::new(),
+            ui: Vec::new(),
             ui_frames: VecDeque::new(),
             hybrid_cpu: Vec::new(),
             hybrid_gpu: Vec::new(),
@@ -151,8 +152,8 @@ impl Readouts {
         self.shown = Shown {
             last: self.last,
             corner,
-            upload_ms: self.upload_ms.last().copied().unwrap_or(0.0),
-            ui_ms: self.ui_ms.last().copied().unwrap_or(0.0),
+            upload: self.upload.last().copied().unwrap_or_default(),
+            ui: self.ui.last().copied().unwrap_or_default(),
             ui_fps: self.ui_fps(),
             until_t: self.history.back().map_or(0.0, |s| s.t),
         };
@@ -201,13 +202,13 @@ impl Readouts {
         })
     }
 
-    /// Records the GPU-side cost of a UI frame: uploading a traced frame (when one was) and building and
-    /// submitting the UI, in milliseconds.
-    pub fn push_ui(&mut self, upload_ms: Option<f64>, ui_ms: f64) {
-        if let Some(u) = upload_ms {
-            self.upload_ms.push(u);
+    /// Records the cost of a UI frame: uploading a traced frame (when one was), and building and submitting
+    /// the UI.
+    pub fn push_ui(&mut self, upload: Option<Cost>, ui: Cost) {
+        if let Some(u) = upload {
+            self.upload.push(u);
         }
-        self.ui_ms.push(ui_ms);
+        self.ui.push(ui);
         let now = Instant::now();
         self.ui_frames.push_back(now);
         while self.ui_frames.front().is_some_and(|t| now.duration_since(*t).as_secs_f64() > 1.0) {
@@ -266,8 +267,9 @@ impl Readouts {
             for ((name, ms), p) in StageTimes::NAMES.iter().zip(st.as_array()).zip(pct) {
                 row(name, format!("{:.2} ms ({p:.0} %)", ms * 1e3));
             }
-            row("upload", format!("{:.3} ms", self.shown.upload_ms));
-            row("UI", format!("{:.3} ms", self.shown.ui_ms));
+            let cost = |c: Cost| format!("{:.2} ms CPU, {:.2} wall", c.cpu_ms, c.wall_ms);
+            row("upload", cost(self.shown.upload));
+            row("UI", cost(self.shown.ui));
         });
         ui.small("stage times are summed over the tracer threads");
         let t0 = self.shown.until_t;
@@ -288,7 +290,9 @@ impl Readouts {
         let mut sorted = self.frame_ms.clone();
         sorted.sort_by(f64::total_cmp);
         let n = sorted.len().max(1) as f64;
-        let mean = |v: &[f64]| if v.is_empty() { 0.0 } else { v.iter().sum::<f64>() / v.len() as f64 };
+        let mean_of = |v: &[Cost], f: fn(&Cost) -> f64| {
+            if v.is_empty() { 0.0 } else { v.iter().map(f).sum::<f64>() / v.len() as f64 }
+        };
         let total_s: f64 = sorted.iter().sum::<f64>() / 1e3;
         StatsReport {
             frames: self.frame_ms.len(),
@@ -303,9 +307,11 @@ impl Readouts {
             i: self.totals.isects_per_packet(),
             culled_pct: culled_pct(&self.totals),
             stage_ms_per_frame: self.stages.as_array().map(|s| s * 1e3 / n),
-            upload_ms_mean: mean(&self.upload_ms),
-            ui_ms_mean: mean(&self.ui_ms),
-            ui_frames: self.ui_ms.len(),
+            upload_ms_mean: mean_of(&self.upload, |c| c.cpu_ms),
+            upload_wall_ms_mean: mean_of(&self.upload, |c| c.wall_ms),
+            ui_ms_mean: mean_of(&self.ui, |c| c.cpu_ms),
+            ui_wall_ms_mean: mean_of(&self.ui, |c| c.wall_ms),
+            ui_frames: self.ui.len(),
         }
     }
 }
@@ -337,10 +343,14 @@ pub struct StatsReport {
     pub culled_pct: f64,
     /// Mean thread-summed ms per frame of each stage, in the order of [`StageTimes::NAMES`].
     pub stage_ms_per_frame: [f64; 5],
-    /// Mean CPU ms to upload a traced frame.
+    /// Mean CPU ms (the UI thread's CPU time) to upload a traced frame.
     pub upload_ms_mean: f64,
-    /// Mean CPU ms to build, encode and submit a UI frame (the upload excluded).
+    /// Mean wall ms of the uploads (their CPU time plus any wait for a core).
+    pub upload_wall_ms_mean: f64,
+    /// Mean CPU ms (the UI thread's CPU time) to build, encode and submit a UI frame (the upload excluded).
     pub ui_ms_mean: f64,
+    /// Mean wall ms of the UI frames (their CPU time plus any wait for a core).
+    pub ui_wall_ms_mean: f64,
     /// UI frames drawn.
     pub ui_frames: usize,
 }
@@ -384,26 +394,30 @@ mod tests {
         assert_eq!(r.refresh_due(), None, "nothing traced, nothing to show");
         r.push_frame(frame(10), StageTimes::default(), 0.1);
         assert_eq!(r.refresh_due(), Some(REFRESH), "a frame waits at most one refresh for a redraw");
-        r.push_ui(Some(0.5), 2.0);
+        let ms = |cpu_ms: f64| Cost { cpu_ms, wall_ms: cpu_ms + 1.0 };
+        r.push_ui(Some(ms(0.5)), ms(2.0));
         r.refresh(None);
         assert_eq!(r.shown.last.map(|l| l.0.rays), Some(10));
-        assert_eq!((r.shown.upload_ms, r.shown.ui_ms), (0.5, 2.0));
+        assert_eq!((r.shown.upload, r.shown.ui), (ms(0.5), ms(2.0)));
         assert_eq!(r.refresh_due(), None);
 
         r.push_frame(frame(20), StageTimes::default(), 0.1);
-        r.push_ui(None, 3.0);
+        r.push_ui(None, ms(3.0));
         let due = r.refresh_due().expect("a frame waits to be shown");
         assert!(due > REFRESH && due <= 2 * REFRESH, "{due:?}");
         r.refresh(None);
         assert_eq!(r.shown.last.map(|l| l.0.rays), Some(10), "too soon: the screen keeps the old figures");
-        assert_eq!(r.shown.ui_ms, 2.0);
+        assert_eq!(r.shown.ui, ms(2.0));
 
         std::thread::sleep(REFRESH);
         assert_eq!(r.refresh_due(), Some(REFRESH));
         r.refresh(None);
         assert_eq!(r.shown.last.map(|l| l.0.rays), Some(20));
-        assert_eq!(r.shown.ui_ms, 3.0);
+        assert_eq!(r.shown.ui, ms(3.0));
         assert_eq!(r.refresh_due(), None);
         assert_eq!(r.report().frames, 2, "the report counts every frame, shown or not");
+        let report = r.report();
+        assert_eq!((report.ui_ms_mean, report.ui_wall_ms_mean), (2.5, 3.5), "UI costs are averaged on both clocks");
+        assert_eq!((report.upload_ms_mean, report.upload_wall_ms_mean), (0.5, 1.5));
     }
 }
