@@ -163,6 +163,24 @@ mod tests {
     }
 }
 
+/// Image-size flags shared by `render`, `trace` and `compare` (the harness's default 512x512).
+#[derive(Args, Clone, Copy, Debug)]
+pub struct ImageArgs {
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
+    pub width: u64,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
+    pub height: u64,
+}
+
+impl ImageArgs {
+    /// Width and height as pixel counts.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width as u32, self.height as u32)
+    }
+}
+
 /// kd-tree cost-model flags (thesis Eq. 2.1); the defaults are [`KdParams::default`].
 #[derive(Args, Clone, Debug)]
 pub struct KdArgs {

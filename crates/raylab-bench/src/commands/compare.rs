@@ -17,7 +17,7 @@ use raylab_core::scene::Scene;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, Workload, WorkloadBuilder};
 
-use crate::args::{KdArgs, SceneArgs, in_range, parse_group};
+use crate::args::{ImageArgs, KdArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene, with_spinner};
 use crate::timing::{DACRT_SET_TILE as DACRT_TILE, HARNESS_TILE, TraceReport, measure, tile_for_group, validate};
@@ -32,12 +32,8 @@ pub struct CompareArgs {
     scene: SceneArgs,
     #[command(flatten)]
     kd: KdArgs,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
-    width: u64,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
-    height: u64,
+    #[command(flatten)]
+    image: ImageArgs,
     /// Thread counts, comma separated.
     #[arg(long, default_value = "1,2", value_delimiter = ',', value_parser = in_range(1, 1024))]
     threads: Vec<u64>,
@@ -119,7 +115,7 @@ fn run_embree(
         .arg(&a.scene.scene)
         .args(["--eye", &v(cam.eye), "--target", &v(cam.target), "--up", &v(cam.up)])
         .args(["--fov", &cam.vfov_deg.to_string(), "--light", &v(light)])
-        .args(["--width", &a.width.to_string(), "--height", &a.height.to_string()])
+        .args(["--width", &a.image.width.to_string(), "--height", &a.image.height.to_string()])
         .args(["--threads", &threads.join(","), "--reps", &a.reps.to_string()])
         .args(["--warmup", &a.warmup.to_string(), "--builds", &builds.to_string()])
         .args(["--kinds", kinds])
@@ -183,7 +179,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     }
     let tree = tree.ok_or("--threads: no thread count given")?;
     let reference = BruteForce::new(&scene);
-    let (w, h) = (a.width as u32, a.height as u32);
+    let (w, h) = a.image.size();
     let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree));
     // Per ray kind: the harness first, then raylab's single rays, then the coherent methods (primary and
     // shadow rays) or the incoherent ones (diffuse rays).

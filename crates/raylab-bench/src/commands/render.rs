@@ -7,7 +7,7 @@ use clap::Args;
 use raylab_bench::still::{Still, render_still};
 use raylab_core::render::{FrameView, RayOrder, RenderSettings};
 
-use crate::args::{KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_positive};
+use crate::args::{ImageArgs, KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_positive};
 
 /// Renders one frame to a PNG file.
 #[derive(Args, Debug)]
@@ -16,12 +16,8 @@ pub struct RenderArgs {
     scene: SceneArgs,
     #[command(flatten)]
     kd: KdArgs,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
-    width: u64,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
-    height: u64,
+    #[command(flatten)]
+    image: ImageArgs,
     /// Output PNG file.
     #[arg(long, default_value = "raylab.png")]
     out: PathBuf,
@@ -60,8 +56,8 @@ impl RenderArgs {
 pub fn run(a: &RenderArgs) -> Result<(), String> {
     let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
     let settings = |light: &_| RenderSettings {
-        width: a.width as u32,
-        height: a.height as u32,
+        width: a.image.size().0,
+        height: a.image.size().1,
         tile: a.m.tile as u32,
         order: a.order,
         shadows: a.shade.shadows(light),

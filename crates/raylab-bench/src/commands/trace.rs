@@ -8,7 +8,7 @@ use raylab_core::trace::Tracer;
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 use serde_json::json;
 
-use crate::args::{KdArgs, MethodArgs, SceneArgs, in_range, parse_group};
+use crate::args::{ImageArgs, KdArgs, MethodArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
 use crate::prepare::{build_tree, load_scene, with_spinner};
 use crate::timing::{measure, tile_for_group, validate};
@@ -20,12 +20,8 @@ pub struct TraceArgs {
     scene: SceneArgs,
     #[command(flatten)]
     kd: KdArgs,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
-    width: u64,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 512, value_parser = in_range(1, 16384))]
-    height: u64,
+    #[command(flatten)]
+    image: ImageArgs,
     /// Ray kind: primary, shadow or diffuse.
     #[arg(long, default_value = "primary")]
     kind: RayKind,
@@ -62,7 +58,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     let (camera, light) = a.scene.camera_and_light(&scene)?;
     let tree = build_tree(&scene, &a.kd.params()?, a.threads as usize)?;
     let reference = BruteForce::new(&scene);
-    let (w, h) = (a.width as u32, a.height as u32);
+    let (w, h) = a.image.size();
     let builder = with_spinner("generating rays", || {
         WorkloadBuilder::new(&scene, &camera, light.position, w, h, &tree).seed(a.seed)
     });
