@@ -55,6 +55,8 @@ pub struct Readouts {
     last: Option<(TraversalStats, StageTimes, f64)>,
     upload: Vec<Cost>,
     ui: Vec<Cost>,
+    /// Per UI frame that uploaded a traced frame: the upload's and the UI's CPU ms together.
+    upload_and_ui_ms: Vec<f64>,
     ui_frames: VecDeque<Instant>,
     /// Hybrid mode, per frame: raster, readback and trace ms, and when the frame arrived.
     hybrid_cpu: Vec<([f64; 3], Instant)>,
@@ -89,6 +91,7 @@ impl Default for Readouts {
             last: None,
             upload: Vec::new(),
             ui: Vec::new(),
+            upload_and_ui_ms: Vec::new(),
             ui_frames: VecDeque::new(),
             hybrid_cpu: Vec::new(),
             hybrid_gpu: Vec::new(),
@@ -187,10 +190,6 @@ impl Readouts {
         if self.hybrid_cpu.is_empty() {
             return None;
         }
-        let median = |mut v: Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(0.0)
-        };
         let cpu = |k: usize| median(self.hybrid_cpu.iter().map(|h| h.0[k]).collect());
         let gpu = |k: usize| median(self.hybrid_gpu.iter().map(|h| h[k]).collect());
         let periods: Vec<f64> =
@@ -207,6 +206,7 @@ impl Readouts {
     pub fn push_ui(&mut self, upload: Option<Cost>, ui: Cost) {
         if let Some(u) = upload {
             self.upload.push(u);
+            self.upload_and_ui_ms.push(u.cpu_ms + ui.cpu_ms);
         }
         self.ui.push(ui);
         let now = Instant::now();
@@ -311,6 +311,9 @@ impl Readouts {
             upload_wall_ms_mean: mean_of(&self.upload, |c| c.wall_ms),
             ui_ms_mean: mean_of(&self.ui, |c| c.cpu_ms),
             ui_wall_ms_mean: mean_of(&self.ui, |c| c.wall_ms),
+            upload_ms_median: median(self.upload.iter().map(|c| c.cpu_ms).collect()),
+            ui_ms_median: median(self.ui.iter().map(|c| c.cpu_ms).collect()),
+            upload_and_ui_ms_median: median(self.upload_and_ui_ms.clone()),
             ui_frames: self.ui.len(),
         }
     }
@@ -351,8 +354,21 @@ pub struct StatsReport {
     pub ui_ms_mean: f64,
     /// Mean wall ms of the UI frames (their CPU time plus any wait for a core).
     pub ui_wall_ms_mean: f64,
+    /// Median CPU ms of an upload (the means also count the first frames' one-off work, such as egui's font
+    /// atlas).
+    pub upload_ms_median: f64,
+    /// Median CPU ms of a UI frame, the upload excluded.
+    pub ui_ms_median: f64,
+    /// Median over the UI frames that showed a new traced frame of their upload and UI CPU ms together.
+    pub upload_and_ui_ms_median: f64,
     /// UI frames drawn.
     pub ui_frames: usize,
+}
+
+/// The median of `v` (the upper one of an even count; 0 when empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// The colour scale of a heat map or the depth view.
@@ -419,5 +435,6 @@ mod tests {
         let report = r.report();
         assert_eq!((report.ui_ms_mean, report.ui_wall_ms_mean), (2.5, 3.5), "UI costs are averaged on both clocks");
         assert_eq!((report.upload_ms_mean, report.upload_wall_ms_mean), (0.5, 1.5));
+        assert_eq!((report.ui_ms_median, report.upload_ms_median, report.upload_and_ui_ms_median), (3.0, 0.5, 2.5));
     }
 }
