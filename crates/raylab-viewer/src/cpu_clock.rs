@@ -1,7 +1,7 @@
 //! What a piece of UI work costs: the calling thread's CPU time, and the wall time it took. On two cores
 //! shared with the tracer threads (and, without a GPU, with the software Vulkan driver's threads), the wall
 //! time of a UI frame also counts the time the thread waited for a core; the CPU time is the work itself,
-//! which is what issue 7's "upload + UI cost" budget is about. Both are reported.
+//! what a budget for the UI's cost per frame is about. Both are reported.
 
 use std::time::{Duration, Instant};
 
