@@ -13,7 +13,7 @@ use super::frustum::{BatchBits, Leaf, front_child, hit_limit, leaf_intersect, le
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::coord;
-use crate::packet::{Bundle, Bundle4, MAX_LANES, PacketTile, bundle_lanes, map3, sign_crossing4};
+use crate::packet::{Bundle, MAX_LANES, PacketTile, bundle_lanes, map3};
 use crate::stats::TraversalStats;
 
 /// Four bundles (pyramid frustums or cones) with a common origin, one per SIMD lane, each through its
@@ -56,23 +56,21 @@ impl<V: Vf32> Frustum4<V> {
     }
 }
 
-impl<V: Vf32> Bundle4<V> for Frustum4<V> {
-    #[inline(always)]
-    fn origin(&self) -> glam::Vec3 {
-        self.origin
-    }
-    #[inline(always)]
-    fn t_range(&self) -> (V, V) {
-        (self.t_min, self.t_max)
-    }
-    #[inline(always)]
-    fn valid(&self) -> V::Mask {
-        self.valid
-    }
+impl<V: Vf32> Frustum4<V> {
+    /// Per lane, the range of distances at which the bundle crosses `coordinate k = split`: the scalar
+    /// [`Bundle::crossing`] in every lane, with one branch on the side of the shared origin.
     #[inline(always)]
     fn crossing(&self, k: usize, split: f32) -> (V, V) {
-        let factors = [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
-        sign_crossing4(split - coord(&self.origin, k), self.origin_slack, factors)
+        let (dist, slack) = (split - coord(&self.origin, k), self.origin_slack);
+        let [pos_near, pos_far, neg_near, neg_far] =
+            [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
+        if dist > slack {
+            (V::splat(dist - slack) * pos_near, V::splat(dist + slack) * pos_far)
+        } else if dist < -slack {
+            (V::splat(dist + slack) * neg_near, V::splat(dist - slack) * neg_far)
+        } else {
+            (V::splat(0.0), V::splat(f32::INFINITY))
+        }
     }
 }
 
@@ -147,9 +145,9 @@ const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 impl KdTree {
     /// Closest hits of the packets of `tile`; `sets[i]` lists the packets that frustum lane `i` bounds.
     #[inline(always)]
-    pub fn intersect_mft<V: Vf32, F: Bundle4<V>>(
+    pub fn intersect_mft<V: Vf32>(
         &self,
-        f: &F,
+        f: &Frustum4<V>,
         tile: &mut PacketTile<V>,
         sets: &[Vec<usize>; 4],
         cull: bool,
@@ -161,9 +159,9 @@ impl KdTree {
     /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` lists the packets
     /// that frustum lane `i` bounds.
     #[inline(always)]
-    pub fn occluded_mft<V: Vf32, F: Bundle4<V>>(
+    pub fn occluded_mft<V: Vf32>(
         &self,
-        f: &F,
+        f: &Frustum4<V>,
         tile: &PacketTile<V>,
         sets: &[Vec<usize>; 4],
         cull: bool,
@@ -182,8 +180,8 @@ impl KdTree {
 
     /// Walks the leaves the four frustums overlap, handing each to `leaf`.
     #[inline(always)]
-    fn traverse_mft<V: Vf32, F: Bundle4<V>>(&self, f: &F, stats: &mut TraversalStats, leaf: &mut impl MftLeaf<V>) {
-        if self.triangles().is_empty() || f.valid().none() {
+    fn traverse_mft<V: Vf32>(&self, f: &Frustum4<V>, stats: &mut TraversalStats, leaf: &mut impl MftLeaf<V>) {
+        if self.triangles().is_empty() || f.valid.none() {
             return;
         }
         let lo_slack = V::splat(1.0 - SPLIT_SLACK);
@@ -192,10 +190,9 @@ impl KdTree {
         let zero = V::splat(0.0);
         let mut stack = [Entry { node: 0, near: zero, far: zero, active: V::Mask::from_bits(0) }; STACK];
         let mut sp = 0usize;
-        let (t_min, t_max) = f.t_range();
-        let origin = f.origin();
+        let (t_min, t_max, origin) = (f.t_min, f.t_max, f.origin);
         let (mut node, mut near, mut far) = (0usize, t_min, t_max);
-        let mut active = f.valid();
+        let mut active = f.valid;
         let mut done = V::Mask::from_bits(0);
         let (mut visited, mut leaves) = (0u64, 0u64);
         'walk: loop {
@@ -229,7 +226,7 @@ impl KdTree {
             let leaf_at = Leaf { tree: self, node: n, near: 0.0 };
             let (limit, finished) = leaf.visit(&leaf_at, near4, (active & !done).bits(), stats);
             done = done | V::Mask::from_bits(finished);
-            if (f.valid() & !done).none() {
+            if (f.valid & !done).none() {
                 break;
             }
             loop {

@@ -15,8 +15,7 @@ use crate::ray::{Hit, Ray};
 pub use batch_cull::BatchCull;
 pub use cone::Cone;
 pub use disc::Disc;
-pub(crate) use tile::sign_crossing4;
-pub use tile::{Bundle, Bundle4, Frustum, PacketTile, overlaps_box, slab_interval};
+pub use tile::{Bundle, Frustum, PacketTile, overlaps_box, slab_interval};
 pub(crate) use woop::{crossing_packet, sheared_test};
 pub use woop::{intersect_packet, occlude_packet};
 

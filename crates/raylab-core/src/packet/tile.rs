@@ -157,18 +157,6 @@ pub trait Bundle {
     }
 }
 
-/// Four bundles with one common origin, one per SIMD lane, for Multiple Frustum Traversal.
-pub trait Bundle4<V: Vf32> {
-    /// The common origin.
-    fn origin(&self) -> Vec3;
-    /// Per lane, the range of distances the walk starts with.
-    fn t_range(&self) -> (V, V);
-    /// Lanes that hold a bundle.
-    fn valid(&self) -> V::Mask;
-    /// Per lane, the range of distances at which the bundle crosses `coordinate k = split`.
-    fn crossing(&self, k: usize, split: f32) -> (V, V);
-}
-
 impl Bundle for Frustum {
     #[inline(always)]
     fn origin(&self) -> Vec3 {
@@ -355,18 +343,6 @@ fn sign_crossing(dist: f32, slack: f32, [pos_near, pos_far, neg_near, neg_far]: 
         ((dist + slack) * neg_near, (dist - slack) * neg_far)
     } else {
         (0.0, f32::INFINITY)
-    }
-}
-
-/// [`sign_crossing`] for one bundle per lane (Multiple Frustum Traversal), all with the same origin.
-#[inline(always)]
-pub(crate) fn sign_crossing4<V: Vf32>(dist: f32, slack: f32, [pos_near, pos_far, neg_near, neg_far]: [V; 4]) -> (V, V) {
-    if dist > slack {
-        (V::splat(dist - slack) * pos_near, V::splat(dist + slack) * pos_far)
-    } else if dist < -slack {
-        (V::splat(dist + slack) * neg_near, V::splat(dist - slack) * neg_far)
-    } else {
-        (V::splat(0.0), V::splat(f32::INFINITY))
     }
 }
 
