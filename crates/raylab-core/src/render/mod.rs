@@ -122,8 +122,11 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
     };
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
-    let done: Vec<TileOut> =
-        tiles.par_iter().map(|&(x0, y0)| ctx.tile(x0, y0, tile.min(w - x0), tile.min(h - y0))).collect();
+    // Each worker's scratch buffers serve tile after tile, so a frame allocates them a few times, not per tile.
+    let done: Vec<TileOut> = tiles
+        .par_iter()
+        .map_init(Scratch::default, |sc, &(x0, y0)| ctx.tile(x0, y0, tile.min(w - x0), tile.min(h - y0), sc))
+        .collect();
 
     let mut rgba = vec![[0, 0, 0, 255]; (w * h) as usize];
     let mut stats = TraversalStats::default();
@@ -199,7 +202,8 @@ struct TileContext<'a> {
     offsets: Vec<(u32, u32)>,
 }
 
-/// Buffers of one block of rays, reused from block to block of a tile, and the tile's shadow state.
+/// Buffers of one block of rays and the shadow techniques' state, reused from block to block and from tile to
+/// tile by one worker.
 #[derive(Default)]
 struct Scratch {
     pixels: Vec<(u32, u32)>,
@@ -217,14 +221,13 @@ impl TileContext<'_> {
 
     /// Renders the `tw x th` tile at `(x0, y0)`. Heat maps trace it unit by unit so that each unit's counters
     /// can be shared among its own pixels; the units are exactly the pieces the method traces anyway.
-    fn tile(&self, x0: u32, y0: u32, tw: u32, th: u32) -> TileOut {
-        let mut out = TileOut::default();
-        let mut scratch = Scratch::default();
+    fn tile(&self, x0: u32, y0: u32, tw: u32, th: u32, scratch: &mut Scratch) -> TileOut {
+        let mut out = TileOut { pixels: Vec::with_capacity((tw * th) as usize), ..TileOut::default() };
         let view = self.settings.view;
         if !view.is_heat_map() {
             // A partial tile at the image's edge keeps the whole tile's order.
             let offsets = self.offsets.iter().copied().filter(|&(dx, dy)| dx < tw && dy < th);
-            self.block((x0, y0), (tw, th), offsets, self.order == RayOrder::Scanline, &mut out, &mut scratch);
+            self.block((x0, y0), (tw, th), offsets, self.order == RayOrder::Scanline, &mut out, scratch);
             return out;
         }
         let (uw, uh) = unit_size(&self.tracer.options, self.tile);
@@ -234,7 +237,7 @@ impl TileContext<'_> {
                 let before = out.stats;
                 let (bw, bh) = (uw.min(tw - ux), uh.min(th - uy));
                 let rows = (0..bh).flat_map(|dy| (0..bw).map(move |dx| (dx, dy)));
-                self.block((x0 + ux, y0 + uy), (bw, bh), rows, true, &mut out, &mut scratch);
+                self.block((x0 + ux, y0 + uy), (bw, bh), rows, true, &mut out, scratch);
                 let work = if view == FrameView::Nodes {
                     out.stats.nodes - before.nodes
                 } else {

@@ -47,15 +47,17 @@ impl<'a> Surface<'a> {
         if !entering {
             geometric = -geometric;
         }
-        let uv = texture_uv(scene, hit);
+        let texture = material.diffuse_texture.and_then(|i| scene.textures.get(i as usize));
+        let normal_map = material.normal_texture.and_then(|i| scene.textures.get(i as usize));
+        // Most surfaces have no texture: they skip the UV interpolation.
+        let uv = if texture.is_some() || normal_map.is_some() { texture_uv(scene, hit) } else { None };
         let mut normal = scene.shading_normal(hit);
-        if let (Some(map), Some(uv)) = (material.normal_texture.and_then(|i| scene.textures.get(i as usize)), uv) {
+        if let (Some(map), Some(uv)) = (normal_map, uv) {
             normal = normal_mapped(scene, hit.tri as usize, normal, map.sample(uv));
         }
         if normal.dot(geometric) < 0.0 {
             normal = -normal;
         }
-        let texture = material.diffuse_texture.and_then(|i| scene.textures.get(i as usize));
         let albedo = match (texture, uv) {
             (Some(t), Some(uv)) => material.base_color * t.sample(uv),
             _ => material.base_color,

@@ -48,13 +48,15 @@ impl DroppedTriangles {
 /// A finished scene, ready for acceleration-structure builds.
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
-    /// Vertex positions.
+    /// Vertex positions; move them with [`Scene::set_vertices`], which keeps the bounds and the face normals
+    /// in step.
     pub positions: Vec<Vec3>,
     /// Per-vertex normals: empty, or one per position.
     pub normals: Vec<Vec3>,
     /// Per-vertex texture coordinates: empty, or one per position.
     pub uvs: Vec<Vec2>,
-    /// The triangles; a triangle's index is its id in hits and counters.
+    /// The triangles; a triangle's index is its id in hits and counters. Fixed once built: the face normals
+    /// are kept per triangle.
     pub triangles: Vec<Triangle>,
     /// Materials; every triangle's material index is valid.
     pub materials: Vec<Material>,
@@ -67,6 +69,8 @@ pub struct Scene {
     /// What the builder removed.
     pub dropped: DroppedTriangles,
     bounds: Aabb,
+    /// Unit geometric normal of each triangle, kept with the positions (every shaded hit needs one).
+    face_normals: Vec<Vec3>,
 }
 
 impl Scene {
@@ -107,6 +111,12 @@ impl Scene {
         }
         self.positions[first..end].copy_from_slice(positions);
         self.bounds = bounds_of(&self.triangles, &self.positions);
+        let moved = first as u32..end as u32;
+        for (i, t) in self.triangles.iter().enumerate() {
+            if t.v.iter().any(|v| moved.contains(v)) {
+                self.face_normals[i] = face_normal(&self.positions, t);
+            }
+        }
         Ok(())
     }
 
@@ -122,9 +132,11 @@ impl Scene {
         (b - a).cross(c - a)
     }
 
-    /// Unit geometric normal of triangle `i`.
+    /// Unit geometric normal of triangle `i`: [`Scene::geometric_normal_unnormalized`] normalised, computed
+    /// when the scene is built and when its vertices move.
+    #[inline]
     pub fn geometric_normal(&self, i: usize) -> Vec3 {
-        self.geometric_normal_unnormalized(i).normalize_or_zero()
+        self.face_normals[i]
     }
 
     /// The shading normal at a hit: interpolated vertex normals when the scene has them, else the geometric
@@ -228,6 +240,7 @@ impl SceneBuilder {
             }
         }
         let bounds = bounds_of(&self.triangles, &self.positions);
+        let face_normals = self.triangles.iter().map(|t| face_normal(&self.positions, t)).collect();
         Scene {
             positions: self.positions,
             normals: self.normals,
@@ -239,8 +252,15 @@ impl SceneBuilder {
             views: self.views,
             dropped,
             bounds,
+            face_normals,
         }
     }
+}
+
+/// Unit normal of triangle `t`, `(v1 - v0) x (v2 - v0)` normalised (zero for a degenerate one).
+fn face_normal(positions: &[Vec3], t: &Triangle) -> Vec3 {
+    let [a, b, c] = t.v.map(|i| positions[i as usize]);
+    (b - a).cross(c - a).normalize_or_zero()
 }
 
 /// Bounds of the vertices the triangles use.
@@ -269,6 +289,25 @@ mod tests {
         assert_eq!(s.materials.len(), 1, "a default material is added for the orphan index");
         assert_eq!(s.bounds(), Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
         assert_eq!(s.geometric_normal(0), Vec3::Z);
+    }
+
+    /// The stored face normals follow the vertices: after a move, every triangle's normal is its corners'
+    /// cross product normalised, for the moved triangles and the untouched ones alike.
+    #[test]
+    fn face_normals_follow_moved_vertices() {
+        let mut b = SceneBuilder::new();
+        b.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(5.0, 0.0, 0.0), Vec3::new(5.0, 0.0, 1.0)];
+        b.triangles = vec![Triangle { v: [0, 1, 2], material: 0 }, Triangle { v: [1, 3, 4], material: 0 }];
+        let mut s = b.build();
+        assert_eq!(s.geometric_normal(0), Vec3::Z);
+        assert_eq!(s.geometric_normal(1), Vec3::NEG_Y);
+        // Turn the second triangle's free corners upward and swap the first's winding through vertex 2.
+        s.set_vertices(2, &[Vec3::NEG_Y, Vec3::new(5.0, 1.0, 0.0), Vec3::new(5.0, 1.0, 1.0)], None).unwrap();
+        for i in 0..s.triangle_count() {
+            assert_eq!(s.geometric_normal(i), s.geometric_normal_unnormalized(i).normalize_or_zero(), "triangle {i}");
+        }
+        assert_eq!(s.geometric_normal(0), Vec3::NEG_Z);
+        assert!(s.geometric_normal(1).dot(Vec3::NEG_Y) < 0.99, "the moved triangle's normal turned");
     }
 
     #[test]
