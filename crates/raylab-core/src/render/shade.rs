@@ -202,8 +202,9 @@ pub fn to_display(v: f32) -> u8 {
         return 255;
     }
     let table = &*DISPLAY;
-    // `v * BUCKETS` is exact (a power of two), so the bucket's lower edge is at or below `v`.
-    let mut byte = table.bucket_start[(v * DisplayTable::BUCKETS as f32) as usize] as usize;
+    // `v * BUCKETS` is exact (a power of two), so the bucket's lower edge is at or below `v`; it lies in
+    // `(0, BUCKETS)`, so the cheaper conversion through `i32` cannot saturate.
+    let mut byte = table.bucket_start[(v * DisplayTable::BUCKETS as f32) as i32 as usize] as usize;
     while v >= table.steps[byte] {
         byte += 1;
     }

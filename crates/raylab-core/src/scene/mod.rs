@@ -141,14 +141,17 @@ impl Scene {
 
     /// The shading normal at a hit: interpolated vertex normals when the scene has them, else the geometric
     /// normal. Not flipped toward the viewer.
+    #[inline]
     pub fn shading_normal(&self, hit: &Hit) -> Vec3 {
-        let t = &self.triangles[hit.tri as usize];
-        if self.normals.len() == self.positions.len() && !self.normals.is_empty() {
-            let [n0, n1, n2] = t.v.map(|i| self.normals[i as usize]);
+        // The builder keeps the normals only when there is one per position.
+        if !self.normals.is_empty() {
+            let [i0, i1, i2] = self.triangles[hit.tri as usize].v;
+            let [n0, n1, n2] = [self.normals[i0 as usize], self.normals[i1 as usize], self.normals[i2 as usize]];
             let n = n0 * (1.0 - hit.u - hit.v) + n1 * hit.u + n2 * hit.v;
-            let n = n.normalize_or_zero();
-            if n != Vec3::ZERO {
-                return n;
+            // `normalize_or_zero`, with its zero case going to the face normal.
+            let rcp = n.length_recip();
+            if rcp.is_finite() && rcp > 0.0 {
+                return n * rcp;
             }
         }
         self.geometric_normal(hit.tri as usize)
