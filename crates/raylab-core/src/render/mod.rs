@@ -223,6 +223,7 @@ impl TileContext<'_> {
     /// can be shared among its own pixels; the units are exactly the pieces the method traces anyway.
     fn tile(&self, x0: u32, y0: u32, tw: u32, th: u32, scratch: &mut Scratch) -> TileOut {
         let mut out = TileOut { pixels: Vec::with_capacity((tw * th) as usize), ..TileOut::default() };
+        scratch.shadow.start_tile();
         let view = self.settings.view;
         if !view.is_heat_map() {
             // A partial tile at the image's edge keeps the whole tile's order.

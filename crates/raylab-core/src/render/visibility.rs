@@ -16,8 +16,8 @@ use crate::trace::Tracer;
 
 use super::shade::{Surface, shadow_ray};
 
-/// Per-tile state of the shadow techniques (the shadow cache, edge-width buffers, light samples), reused from
-/// layer to layer; one per worker task, never shared.
+/// State of the shadow techniques (the shadow cache, edge-width buffers, light samples), reused from
+/// layer to layer and tile to tile ([`ShadowScratch::start_tile`]); one per worker, never shared.
 #[derive(Default)]
 pub struct ShadowScratch {
     cache: ShadowCache,
@@ -39,6 +39,14 @@ pub struct ShadowTracer<'a> {
     pub shadows: Shadows,
     /// How far shadow rays start off the surface, along its geometric normal.
     pub epsilon: f32,
+}
+
+impl ShadowScratch {
+    /// Starts a new tile: the shadow cache forgets its blocker, which a tile elsewhere in the image found
+    /// (kept, it would cost every lit ray of the new tile a test that rarely succeeds).
+    pub fn start_tile(&mut self) {
+        self.cache = ShadowCache::default();
+    }
 }
 
 impl ShadowTracer<'_> {
