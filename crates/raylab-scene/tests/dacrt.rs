@@ -6,8 +6,8 @@
 
 mod common;
 
-use common::{T_REL_TOL, adversarial_rays, check_hits};
-use glam::{Affine3A, Vec3};
+use common::{T_REL_TOL, adversarial_rays, check_hits, incoherent, scaled_scenes};
+use glam::Vec3;
 use raylab_core::dacrt::{Dacrt, DacrtParams, SplitRule};
 use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::method::Method;
@@ -20,25 +20,6 @@ use raylab_scene::MeshBuilder;
 use raylab_scene::builtin::{self, Detail};
 use raylab_scene::mesh::Jitter;
 use raylab_simd::Backend;
-
-/// Random segments with origins in and around the scene (some with tmin > 0 or a finite tmax).
-fn incoherent(scene: &Scene, n: usize, seed: u32) -> Vec<Ray> {
-    let mut rng = Jitter::new(seed);
-    let b = scene.bounds();
-    let pad = b.extent() * 0.1;
-    let (lo, hi) = (b.min - pad, b.max + pad);
-    (0..n)
-        .map(|k| {
-            let o = Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
-            let d = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
-            match k % 3 {
-                0 => Ray::new(o, d),
-                1 => Ray::segment(o, d, rng.range(0.0, 0.5), rng.range(0.5, 8.0)),
-                _ => Ray::segment(o, d, 0.0, b.diagonal() * rng.unit()),
-            }
-        })
-        .collect()
-}
 
 /// `adversarial` adversarial rays (seeded by `adversarial_seed`) then `random` incoherent ones (`random_seed`)
 /// for `scene`.
@@ -247,18 +228,11 @@ fn degenerate_scenes_and_extreme_coordinates() {
         "one",
     );
 
-    for (scale, offset) in
-        [(1e4f32, Vec3::ZERO), (1e-4, Vec3::ZERO), (1.0, Vec3::splat(1e5)), (1e-3, Vec3::splat(-50.0))]
-    {
-        let mut mb = MeshBuilder::new();
-        mb.set_transform(Affine3A::from_translation(offset) * Affine3A::from_scale(Vec3::splat(scale)));
-        mb.cuboid(Vec3::splat(-1.0), Vec3::ONE);
-        mb.sphere(Vec3::new(3.0, 0.0, 0.0), 1.0, 8, 12);
-        let scene = mb.build();
+    for (name, scene) in scaled_scenes() {
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
         let d = Dacrt::new(&scene);
         let p = DacrtParams::default();
-        check_sets(&scene, &d, &p, &adversarial_rays(&scene, &kd, 100, 9), 512, &format!("scale {scale}"));
+        check_sets(&scene, &d, &p, &adversarial_rays(&scene, &kd, 100, 9), 512, &name);
     }
 
     // Triangles spaced ever wider along a line: SAH cuts off one at a time, as deep as it can.

@@ -4,38 +4,17 @@
 
 mod common;
 
-use common::{adversarial_rays, check_hits};
-use glam::{Affine3A, Vec3};
+use common::{adversarial_rays, check_hits, incoherent, scaled_scenes};
+use glam::Vec3;
 use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::mbvh::{EMPTY, Mbvh};
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
-use raylab_core::scene::{Scene, SceneBuilder, Triangle};
+use raylab_core::scene::{SceneBuilder, Triangle};
 use raylab_core::stats::TraversalStats;
-use raylab_scene::MeshBuilder;
 use raylab_scene::builtin::{self, Detail};
 use raylab_scene::mesh::Jitter;
 use raylab_simd::Backend;
-
-/// Random incoherent segments: origins anywhere in (and around) the scene, random directions, some with
-/// tmin > 0 and a finite tmax.
-fn incoherent(scene: &Scene, n: usize, seed: u32) -> Vec<Ray> {
-    let mut rng = Jitter::new(seed);
-    let b = scene.bounds();
-    let pad = b.extent() * 0.1;
-    let (lo, hi) = (b.min - pad, b.max + pad);
-    (0..n)
-        .map(|k| {
-            let o = Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
-            let d = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
-            match k % 3 {
-                0 => Ray::new(o, d),
-                1 => Ray::segment(o, d, rng.range(0.0, 0.5), rng.range(0.5, 8.0)),
-                _ => Ray::segment(o, d, 0.0, b.diagonal() * rng.unit()),
-            }
-        })
-        .collect()
-}
 
 #[test]
 fn mbvh_matches_brute_force_on_every_builtin_scene_and_backend() {
@@ -120,17 +99,10 @@ fn empty_scene_single_triangle_and_extreme_coordinates() {
         "one",
     );
 
-    for (scale, offset) in
-        [(1e4f32, Vec3::ZERO), (1e-4, Vec3::ZERO), (1.0, Vec3::splat(1e5)), (1e-3, Vec3::splat(-50.0))]
-    {
-        let mut mb = MeshBuilder::new();
-        mb.set_transform(Affine3A::from_translation(offset) * Affine3A::from_scale(Vec3::splat(scale)));
-        mb.cuboid(Vec3::splat(-1.0), Vec3::ONE);
-        mb.sphere(Vec3::new(3.0, 0.0, 0.0), 1.0, 8, 12);
-        let scene = mb.build();
+    for (name, scene) in scaled_scenes() {
         let m = Mbvh::build(&scene);
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-        check_hits(&scene, &m, &adversarial_rays(&scene, &kd, 100, 9), &format!("scale {scale}"));
+        check_hits(&scene, &m, &adversarial_rays(&scene, &kd, 100, 9), &name);
     }
 }
 

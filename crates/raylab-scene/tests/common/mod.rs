@@ -2,13 +2,14 @@
 
 #![allow(dead_code)]
 
-use glam::Vec3;
+use glam::{Affine3A, Vec3};
 use raylab_core::kdtree::KdTree;
 use raylab_core::method::Intersector;
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
 use raylab_core::scene::Scene;
 use raylab_core::stats::TraversalStats;
+use raylab_scene::MeshBuilder;
 use raylab_scene::mesh::Jitter;
 
 /// Relative tolerance on hit distances between two methods that report the same triangle or distance.
@@ -96,4 +97,39 @@ pub fn adversarial_rays(scene: &Scene, tree: &KdTree, n: usize, seed: u32) -> Ve
         rays.push(Ray::new(o, d));
     }
     rays
+}
+
+/// Random incoherent segments: origins anywhere in (and around) the scene, random directions, some with
+/// tmin > 0 and a finite tmax.
+pub fn incoherent(scene: &Scene, n: usize, seed: u32) -> Vec<Ray> {
+    let mut rng = Jitter::new(seed);
+    let b = scene.bounds();
+    let pad = b.extent() * 0.1;
+    let (lo, hi) = (b.min - pad, b.max + pad);
+    (0..n)
+        .map(|k| {
+            let o = Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
+            let d = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            match k % 3 {
+                0 => Ray::new(o, d),
+                1 => Ray::segment(o, d, rng.range(0.0, 0.5), rng.range(0.5, 8.0)),
+                _ => Ray::segment(o, d, 0.0, b.diagonal() * rng.unit()),
+            }
+        })
+        .collect()
+}
+
+/// A box beside a sphere at extreme scales and offsets (10^4 and 10^-4 units, 10^5 from the origin, tiny
+/// and off-centre), each named by its scale.
+pub fn scaled_scenes() -> Vec<(String, Scene)> {
+    [(1e4f32, Vec3::ZERO), (1e-4, Vec3::ZERO), (1.0, Vec3::splat(1e5)), (1e-3, Vec3::splat(-50.0))]
+        .into_iter()
+        .map(|(scale, offset)| {
+            let mut mb = MeshBuilder::new();
+            mb.set_transform(Affine3A::from_translation(offset) * Affine3A::from_scale(Vec3::splat(scale)));
+            mb.cuboid(Vec3::splat(-1.0), Vec3::ONE);
+            mb.sphere(Vec3::new(3.0, 0.0, 0.0), 1.0, 8, 12);
+            (format!("scale {scale}"), mb.build())
+        })
+        .collect()
 }
