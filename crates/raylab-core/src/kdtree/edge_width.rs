@@ -89,7 +89,7 @@ impl KdTree {
             }
             stats.rays += group.len() as u64;
             stats.packets += 1;
-            let mut walk = EdgeWalks { tree: self, p: &p, states: &mut *states, tests: 0 };
+            let mut walk = EdgeWalks { tree: self, p: &p, states: &mut *states, pending: 0, tests: 0 };
             self.traverse_packet(&p, Front::Signs(sign as usize), &mut stack, stats, &mut walk);
             stats.isect_tests += walk.tests;
             for (s, &(i, _)) in states.iter_mut().zip(group) {
@@ -106,6 +106,9 @@ struct EdgeWalks<'a, V: Vf32> {
     tree: &'a KdTree,
     p: &'a RayPacket<V>,
     states: &'a mut [EdgeWidth],
+    /// The lanes whose states hold crossings not yet committed: only they can change, or finish, at the end
+    /// of a leaf, and most leaves end with none.
+    pending: u32,
     tests: u64,
 }
 
@@ -131,18 +134,25 @@ impl<V: Vf32> PacketLeaf<V> for EdgeWalks<'_, V> {
                 if !state.seen(id) {
                     let dir = Vec3::new(self.p.dir[0].lane(i), self.p.dir[1].lane(i), self.p.dir[2].lane(i));
                     state.add(Crossing { t: t[i], tri: id, front: n.dot(dir) < 0.0 });
+                    self.pending |= 1 << i;
                 }
             }
         }
-        let mut far = [0.0f32; MAX_LANES];
-        t_far.write_to(&mut far[..V::LANES]);
         let mut finished = 0u32;
-        let mut bits = active.bits();
-        while bits != 0 {
-            let i = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            if self.states[i].commit(far[i] * (1.0 + SPLIT_SLACK), tris) {
-                finished |= 1 << i;
+        let mut bits = active.bits() & self.pending;
+        if bits != 0 {
+            let mut far = [0.0f32; MAX_LANES];
+            t_far.write_to(&mut far[..V::LANES]);
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let state = &mut self.states[i];
+                if state.commit(far[i] * (1.0 + SPLIT_SLACK), tris) {
+                    finished |= 1 << i;
+                }
+                if !state.has_pending() {
+                    self.pending &= !(1 << i);
+                }
             }
         }
         (self.p.tmax, V::Mask::from_bits(finished))

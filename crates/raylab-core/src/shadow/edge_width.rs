@@ -66,6 +66,12 @@ impl EdgeWidth {
         self.seen.contains(&tri)
     }
 
+    /// True when crossings wait to be committed ([`EdgeWidth::commit`] has work to do).
+    #[inline]
+    pub fn has_pending(&self) -> bool {
+        !self.pending.is_empty()
+    }
+
     /// Records a crossing found in the current leaf.
     pub fn add(&mut self, c: Crossing) {
         self.seen.push(c.tri);
