@@ -104,6 +104,13 @@ impl EdgeWidth {
             if t.is_finite() && end + tolerance(end) > t {
                 break;
             }
+            // Most crossings are alone at their place: one toggle, without the grouping below.
+            let n = self.pending.len();
+            if n == 1 || self.pending[n - 2].t > end {
+                self.pending.pop();
+                self.toggle(first, tris);
+                continue;
+            }
             let (mut front, mut back): (Option<Crossing>, Option<Crossing>) = (None, None);
             while let Some(&c) = self.pending.last() {
                 if c.t > end {
