@@ -55,9 +55,10 @@ impl RenderArgs {
 /// Runs the command.
 pub fn run(a: &RenderArgs) -> Result<(), String> {
     let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
+    let (width, height) = a.image.size();
     let settings = |light: &_| RenderSettings {
-        width: a.image.size().0,
-        height: a.image.size().1,
+        width,
+        height,
         tile: a.m.tile as u32,
         order: a.order,
         shadows: a.shade.shadows(light),

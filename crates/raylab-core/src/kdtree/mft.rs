@@ -54,9 +54,7 @@ impl<V: Vf32> Frustum4<V> {
             valid: V::Mask::from_bits(valid),
         })
     }
-}
 
-impl<V: Vf32> Frustum4<V> {
     /// Per lane, the range of distances at which the bundle crosses `coordinate k = split`: the scalar
     /// [`Bundle::crossing`] in every lane, with one branch on the side of the shared origin.
     #[inline(always)]
