@@ -25,7 +25,7 @@ pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::from_array(v))
 }
 
-/// Parses a SIMD backend name (`avx2`, `sse2` or `scalar`); refuses one this CPU cannot run.
+/// Parses a SIMD backend name (`avx512`, `avx2`, `sse2` or `scalar`); refuses one this CPU cannot run.
 pub fn parse_backend(s: &str) -> Result<raylab_simd::Backend, String> {
     let avail = raylab_simd::Backend::available();
     avail.iter().copied().find(|b| b.name() == s).ok_or_else(|| {
@@ -226,8 +226,9 @@ pub struct MethodArgs {
     /// Turn packet/leaf culling off (frustum methods).
     #[arg(long)]
     pub no_cull: bool,
-    /// SIMD backend of packet kernels: avx2 (4x2 packets, where the CPU has AVX2 and FMA), sse2 (2x2
-    /// packets, any x86-64) or scalar (2x2); default: the fastest this CPU runs.
+    /// SIMD backend of packet kernels: avx512 (4x4 packets, where the CPU has AVX-512F/VL), avx2 (4x2
+    /// packets, where it has AVX2 and FMA), sse2 (2x2 packets, any x86-64) or scalar (2x2); default: the
+    /// fastest this CPU runs.
     #[arg(long, value_parser = parse_backend)]
     pub backend: Option<raylab_simd::Backend>,
     /// Widest shadow bundle seen from the light (tangent of its half-angle) that frustum methods trace as a

@@ -67,6 +67,9 @@ fn simd_features() -> Vec<&'static str> {
     if is_x86_feature_detected!("fma") {
         v.push("fma");
     }
+    if is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") {
+        v.push("avx512f/vl");
+    }
     v
 }
 

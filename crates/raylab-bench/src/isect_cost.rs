@@ -3,7 +3,7 @@
 //!
 //! A frame's kernels interleave node steps and triangle tests too finely to time apart (a clock read per leaf
 //! would cost more than the tests). Instead the renderer counts the tests of each trace stage, and this module
-//! times the same kernel on the same kind of work alone: packets (2x2, or 4x2 with eight lanes) of the view's
+//! times the same kernel on the same kind of work alone: packets (2x2, 4x2 or 4x4, as wide as the lanes) of the view's
 //! primary rays, each tested against the triangles of the kd-tree leaves its rays end in (the leaves a
 //! traversal tests last, holding both the hit and its neighbours' misses). The caches are warm here, so the
 //! intersection share it gives is a lower bound.

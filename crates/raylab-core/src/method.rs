@@ -19,7 +19,7 @@ pub enum Method {
     /// One ray at a time through the kd-tree (thesis Listing 2.2).
     #[default]
     Mono,
-    /// Omni-directional ray packets, 2x2 (4x2 with AVX2) (thesis 4.1.2, Listing 4.1).
+    /// Omni-directional ray packets, 2x2 (4x2 with AVX2, 4x4 with AVX-512) (thesis 4.1.2, Listing 4.1).
     Packet,
     /// One frustum per tile with interval traversal and packet/leaf culling (Listing 4.2, 4.1.3-4.1.4).
     Frustum,

@@ -15,6 +15,8 @@ pub mod scalar;
 #[cfg(target_arch = "x86_64")]
 pub mod sse;
 #[cfg(target_arch = "x86_64")]
+mod x16;
+#[cfg(target_arch = "x86_64")]
 mod x8;
 
 /// A lane mask produced by comparisons.
@@ -121,6 +123,10 @@ pub enum Backend {
     /// take any width (4x2 ray packets, DACRT's filter and leaves) and two rays per four-wide node test in
     /// MBVH ray streams; single-ray MBVH traversal, whose vectors are its four-wide nodes, uses SSE with it.
     Avx2,
+    /// AVX-512 (F and VL) with AVX2 and FMA on x86-64 CPUs that have them (checked at run time): sixteen lanes,
+    /// 4x4 ray packets, for the kernels that take any width; the kernels written for at most eight lanes (MBVH
+    /// ray streams, DACRT) run as under [`Backend::Avx2`] ([`Backend::at_most_eight_lanes`]).
+    Avx512,
 }
 
 impl Backend {
@@ -134,6 +140,9 @@ impl Backend {
         let mut v = Vec::new();
         #[cfg(target_arch = "x86_64")]
         {
+            if avx512_detected() {
+                v.push(Backend::Avx512);
+            }
             if avx2_detected() {
                 v.push(Backend::Avx2);
             }
@@ -161,6 +170,16 @@ impl Backend {
             Backend::Scalar => "scalar",
             Backend::Sse => "sse2",
             Backend::Avx2 => "avx2",
+            Backend::Avx512 => "avx512",
+        }
+    }
+
+    /// This backend, or [`Backend::Avx2`] in place of [`Backend::Avx512`]: for kernels whose layouts hold at
+    /// most eight lanes (one or two rays per four-wide MBVH node test, DACRT's eight-box filter).
+    pub fn at_most_eight_lanes(self) -> Self {
+        match self {
+            Backend::Avx512 => Backend::Avx2,
+            b => b,
         }
     }
 }
@@ -177,17 +196,27 @@ pub trait Kernel {
     fn run<V: Vf32>(self) -> Self::Output;
 }
 
-/// Runs `k` with the widest vectors `backend` offers on this CPU: eight lanes for [`Backend::Avx2`] (when the
-/// CPU lacks AVX2, SSE instead), four otherwise.
+/// Runs `k` with the widest vectors `backend` offers on this CPU: sixteen lanes for [`Backend::Avx512`], eight
+/// for [`Backend::Avx2`] (a backend the CPU lacks falls back to the next narrower one), four otherwise.
 pub fn dispatch<K: Kernel>(backend: Backend, k: K) -> K::Output {
     match backend {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the guard checked that the CPU has AVX2 and FMA, every feature `run_avx2` is compiled for.
-        Backend::Avx2 if avx2_detected() => unsafe { run_avx2(k) },
+        // SAFETY: the guard checked that the CPU has AVX-512F/VL, AVX2 and FMA, every feature `run_avx512` is
+        // compiled for.
+        Backend::Avx512 if avx512_detected() => unsafe { run_avx512(k) },
         #[cfg(target_arch = "x86_64")]
-        Backend::Sse | Backend::Avx2 => k.run::<sse::F32x4>(),
+        // SAFETY: the guard checked that the CPU has AVX2 and FMA, every feature `run_avx2` is compiled for.
+        Backend::Avx2 | Backend::Avx512 if avx2_detected() => unsafe { run_avx2(k) },
+        #[cfg(target_arch = "x86_64")]
+        Backend::Sse | Backend::Avx2 | Backend::Avx512 => k.run::<sse::F32x4>(),
         _ => k.run::<scalar::F32x4>(),
     }
+}
+
+/// True when this CPU has AVX-512F and AVX-512VL besides AVX2 and FMA ([`Backend::Avx512`]).
+#[cfg(target_arch = "x86_64")]
+fn avx512_detected() -> bool {
+    is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") && avx2_detected()
 }
 
 /// True when this CPU has AVX2 and FMA ([`Backend::Avx2`]).
@@ -204,11 +233,20 @@ fn run_avx2<K: Kernel>(k: K) -> K::Output {
     k.run::<x8::F32x8>()
 }
 
+/// Runs `k` with sixteen lanes, compiled for AVX-512F/VL, AVX2 and FMA, so the kernel's inlined code and
+/// [`x16::F32x16`]'s intrinsics become 512-bit instructions. The only place an `F32x16` is created (see the
+/// `x16` module).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+fn run_avx512<K: Kernel>(k: K) -> K::Output {
+    k.run::<x16::F32x16>()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The lane semantics every backend must share, on lanes 0..4 and (where there are eight) 4..8.
+    /// The lane semantics every backend must share, on every group of four lanes (one, two or four groups).
     struct Semantics;
 
     impl Kernel for Semantics {
@@ -216,14 +254,14 @@ mod tests {
         fn run<V: Vf32>(self) {
             let a4 = [1.0, -2.0, f32::NAN, 0.0];
             let b4 = [0.5, 3.0, 1.0, -0.0];
-            let (mut a, mut b) = ([0.0f32; 8], [0.0f32; 8]);
-            for i in 0..8 {
+            let (mut a, mut b) = ([0.0f32; 16], [0.0f32; 16]);
+            for i in 0..16 {
                 a[i] = a4[i % 4];
                 b[i] = b4[i % 4];
             }
             let n = V::LANES;
             let (a, b) = (V::from_slice(&a[..n]), V::from_slice(&b[..n]));
-            let rep = |bits4: u32| if n == 8 { bits4 | bits4 << 4 } else { bits4 };
+            let rep = |bits4: u32| (0..n / 4).fold(0, |m, g| m | bits4 << (4 * g));
             assert_eq!(a.lt(b).bits(), rep(0b0010));
             assert_eq!(a.le(b).bits(), rep(0b1010), "0.0 <= -0.0");
             assert_eq!(a.eq(b).bits(), rep(0b1000));
@@ -236,19 +274,22 @@ mod tests {
             let sel = V::select(V::Mask::from_bits(rep(0b0101)), a, b);
             assert_eq!([sel.lane(0), sel.lane(1), sel.lane(n - 3)], [1.0, 3.0, 3.0]);
             assert_eq!(a.abs().lane(n - 3), 2.0);
-            let r = V::from_slice(&[2.0, 0.25, -1.0, -0.0, 3.0, 1e30, 7.0, 0.5][..n]).sqrt();
-            for (i, x) in [2.0f32, 0.25, -1.0, -0.0, 3.0, 1e30, 7.0, 0.5][..n].iter().enumerate() {
+            let roots = [2.0f32, 0.25, -1.0, -0.0, 3.0, 1e30, 7.0, 0.5, 9.0, 1e-30, 5.0, 0.0, 2.5, 64.0, 3e3, 1e-3];
+            let r = V::from_slice(&roots[..n]).sqrt();
+            for (i, x) in roots[..n].iter().enumerate() {
                 assert_eq!(r.lane(i).to_bits(), x.sqrt().to_bits(), "sqrt of {x}");
             }
             assert_eq!(a.reduce_min(), -2.0);
             assert_eq!(a.reduce_max(), 1.0);
             assert!(V::splat(f32::NAN).reduce_min().is_nan() && V::splat(f32::NAN).reduce_max().is_nan());
-            let mut one = [f32::NAN; 8];
+            let mut one = [f32::NAN; 16];
             one[n - 1] = -3.5;
             assert_eq!((V::from_slice(&one[..n]).reduce_min(), V::from_slice(&one[..n]).reduce_max()), (-3.5, -3.5));
-            let inf = V::from_slice(&[f32::INFINITY, f32::NEG_INFINITY, 4.0, 1.0, 9.0, -7.0, 2.0, 0.0][..n]);
+            let mut spread = [1.0f32; 16];
+            (spread[1], spread[n - 2]) = (f32::INFINITY, f32::NEG_INFINITY);
+            let inf = V::from_slice(&spread[..n]);
             assert_eq!((inf.reduce_min(), inf.reduce_max()), (f32::NEG_INFINITY, f32::INFINITY));
-            let mut out = [0.0; 8];
+            let mut out = [0.0; 16];
             (a + b).write_to(&mut out[..n]);
             assert_eq!([out[0], out[n - 4]], [1.5, 1.5]);
             assert!((a * b - a / b).lane(1) == -6.0 + 2.0 / 3.0);
@@ -258,7 +299,7 @@ mod tests {
             assert_eq!(V::Mask::from_bits(u32::MAX).bits(), all);
             assert_eq!((V::Mask::from_bits(0b0110) ^ V::Mask::from_bits(0b0011)).bits(), 0b0101);
             assert_eq!(V::splat(2.5).lane(n - 1), 2.5);
-            let rows: Vec<[f32; 4]> = (0..8).map(|i| [i as f32, 10.0 + i as f32, -(i as f32), f32::NAN]).collect();
+            let rows: Vec<[f32; 4]> = (0..16).map(|i| [i as f32, 10.0 + i as f32, -(i as f32), f32::NAN]).collect();
             let refs: Vec<&[f32; 4]> = rows.iter().collect();
             let spread = V::splat_rows(&refs);
             let quad = V::repeat4(&[1.0, 2.0, 3.0, 4.0]);
@@ -302,6 +343,12 @@ mod tests {
             let eight = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
             assert_eq!(avail.contains(&Backend::Avx2), eight);
             assert_eq!(Backend::Avx2.lanes(), if eight { 8 } else { 4 }, "without AVX2 the backend falls back");
+            let sixteen = eight && is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl");
+            assert_eq!(avail.contains(&Backend::Avx512), sixteen);
+            let wide = if sixteen { 16 } else { Backend::Avx2.lanes() };
+            assert_eq!(Backend::Avx512.lanes(), wide, "without AVX-512 the backend falls back");
+            assert_eq!(Backend::Avx512.at_most_eight_lanes(), Backend::Avx2);
+            assert!(Backend::Avx512.at_most_eight_lanes().lanes() <= 8);
         }
     }
 }

@@ -276,7 +276,8 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     }
     if !coherent.is_empty() {
         let backend = TraceOptions::default().backend;
-        let packet = format!("{}x2", backend.lanes() / 2);
+        let (pw, ph) = raylab_core::packet::packet_shape(backend.lanes());
+        let packet = format!("{pw}x{ph}");
         let _ = writeln!(
             md,
             "\nCoherent methods against Embree's best packet or stream API for the same rays and thread count \

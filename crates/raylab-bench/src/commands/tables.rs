@@ -60,7 +60,7 @@ pub struct TablesArgs {
     #[arg(long)]
     images: Option<PathBuf>,
     /// SIMD backend of Tables 4.1-4.5 (default: sse2 where there is one, whose 2x2 packets make N and I per
-    /// 2x2 packet as in the thesis; avx2 traces 4x2 packets).
+    /// 2x2 packet as in the thesis; avx2 traces 4x2 packets, avx512 4x4).
     #[arg(long, value_parser = crate::args::parse_backend)]
     backend: Option<Backend>,
 }

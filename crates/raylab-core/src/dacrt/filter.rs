@@ -59,7 +59,7 @@ pub(super) fn classify<const N: usize>(
     boxes: &[FilterBox; N],
     flags: &mut Vec<u8>,
 ) {
-    raylab_simd::dispatch(backend, Classify { rays, boxes, flags });
+    raylab_simd::dispatch(backend.at_most_eight_lanes(), Classify { rays, boxes, flags });
 }
 
 /// [`classify_lanes`] as a [`Kernel`].

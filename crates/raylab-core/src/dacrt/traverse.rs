@@ -189,7 +189,7 @@ impl<A: Answer> Walk<'_, A> {
             self.stats.leaves += 1;
             self.stats.isect_tests += (rays.len() * tris.len()) as u64;
             let leaf = LeafKernel { answer: &mut self.answer, soup: self.soup, rays, tris };
-            raylab_simd::dispatch(self.backend, leaf);
+            raylab_simd::dispatch(self.backend.at_most_eight_lanes(), leaf);
             return;
         };
         let step = rays.len().div_ceil(ORDER_SAMPLES);

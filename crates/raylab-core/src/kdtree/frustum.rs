@@ -42,8 +42,9 @@ pub(super) struct Leaf<'a> {
 
 /// The batched culling verdicts ([`crate::packet::BatchCull`]) of one leaf for the last `SLOTS` chunks of
 /// packets asked about, in a direct-mapped cache: a loop over packets in index order tests each chunk once
-/// with one slot, and MFT's four quadrants, whose packets take turns in the same chunks (a quadrant of a
-/// 16x16 tile spans two chunks of eight 4x2 packets, shared with the quadrant beside it), need four. Verdicts
+/// with one slot, and MFT's four quadrants, whose packets take turns in the same chunks (with eight lanes, a
+/// quadrant of a 16x16 tile spans two chunks of eight 4x2 packets, shared with the quadrant beside it), need
+/// four. Verdicts
 /// stay valid while the leaf's packets find hits: a closer hit only makes a verdict more permissive than it
 /// needs to be.
 pub(super) struct BatchBits<const SLOTS: usize> {

@@ -74,7 +74,7 @@ impl Mbvh {
     pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
         match self.backend {
             #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
+            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 | raylab_simd::Backend::Avx512 => {
                 self.intersect_with::<raylab_simd::sse::F32x4>(ray, stats)
             }
             _ => self.intersect_with::<raylab_simd::scalar::F32x4>(ray, stats),
@@ -138,7 +138,7 @@ impl Mbvh {
     pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         match self.backend {
             #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 => {
+            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 | raylab_simd::Backend::Avx512 => {
                 self.occluder_with::<raylab_simd::sse::F32x4>(ray, stats)
             }
             _ => self.occluder_with::<raylab_simd::scalar::F32x4>(ray, stats),

@@ -121,13 +121,19 @@ impl Mbvh {
         stats: &mut TraversalStats,
     ) {
         let emit = |i: usize, _: &Hot, s: &Slot| out[i] = s.hit;
-        raylab_simd::dispatch(self.backend, Stream { mbvh: self, rays, shadow: false, ordered, stats, emit });
+        raylab_simd::dispatch(
+            self.backend.at_most_eight_lanes(),
+            Stream { mbvh: self, rays, shadow: false, ordered, stats, emit },
+        );
     }
 
     /// Occlusion of a group of rays traced together; each ray leaves the stream at its first blocker.
     pub fn occluded_stream(&self, rays: &[Option<Ray>], out: &mut [bool], ordered: bool, stats: &mut TraversalStats) {
         let emit = |i: usize, h: &Hot, _: &Slot| out[i] = h.blocked();
-        raylab_simd::dispatch(self.backend, Stream { mbvh: self, rays, shadow: true, ordered, stats, emit });
+        raylab_simd::dispatch(
+            self.backend.at_most_eight_lanes(),
+            Stream { mbvh: self, rays, shadow: true, ordered, stats, emit },
+        );
     }
 
     /// Traces a group with box tests in `B` (one ray per four lanes) and leaf packets in `V` (four lanes).

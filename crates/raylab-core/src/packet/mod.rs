@@ -15,12 +15,12 @@ use crate::ray::{Hit, Ray};
 pub use batch_cull::BatchCull;
 pub use cone::Cone;
 pub use disc::Disc;
-pub use tile::{Bundle, Frustum, PacketTile, overlaps_box, slab_interval};
+pub use tile::{Bundle, Frustum, PacketTile, overlaps_box, packet_shape, slab_interval};
 pub(crate) use woop::{crossing_packet, sheared_test};
 pub use woop::{intersect_packet, occlude_packet};
 
-/// Most lanes a packet may have (8 for AVX).
-pub const MAX_LANES: usize = 8;
+/// Most lanes a packet may have (16, for AVX-512).
+pub const MAX_LANES: usize = 16;
 
 /// Up to [`Vf32::LANES`] rays in SoA form, with the per-lane constants of the watertight test.
 #[derive(Clone, Copy, Debug)]

@@ -1,5 +1,5 @@
-//! A tile of rays cut into 2x2 packets (4x2 with eight lanes), the unit that frustum kernels trace and cull
-//! (thesis 4.1.3-4.1.5).
+//! A tile of rays cut into 2x2 packets (4x2 with eight lanes, 4x4 with sixteen), the unit that frustum kernels
+//! trace and cull (thesis 4.1.3-4.1.5).
 
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
@@ -8,8 +8,16 @@ use super::{BatchCull, Disc, PacketHits, RayPacket, map3};
 use crate::aabb::{Aabb, coord};
 use crate::ray::Ray;
 
-/// The packets of a `width x height` tile in row-major pixel order, each `w = V::LANES / 2` pixels wide and
-/// 2 high; lane `i` holds pixel `(w bx + i % w, 2 by + i / w)`. Pixels outside the tile leave lanes empty.
+/// Width and height in pixels of a packet of `lanes` rays: 2x2 for four lanes, 4x2 for eight, 4x4 for sixteen
+/// (as square as the lanes allow, so a packet's rays stay coherent).
+pub const fn packet_shape(lanes: usize) -> (usize, usize) {
+    let w = if lanes >= 8 { 4 } else { 2 };
+    (w, lanes / w)
+}
+
+/// The packets of a `width x height` tile in row-major pixel order, each [`Self::PACKET_W`] (`w`) pixels wide
+/// and [`Self::PACKET_H`] (`h`) high; lane `i` holds pixel `(w bx + i % w, h by + i / w)`. Pixels outside the
+/// tile leave lanes empty.
 pub struct PacketTile<V: Vf32> {
     /// The packets.
     pub packets: Vec<RayPacket<V>>,
@@ -34,10 +42,10 @@ pub struct PacketTile<V: Vf32> {
 }
 
 impl<V: Vf32> PacketTile<V> {
-    /// Packet width in pixels.
-    pub const PACKET_W: usize = V::LANES / 2;
-    /// Packet height in pixels.
-    pub const PACKET_H: usize = 2;
+    /// Packet width in pixels ([`packet_shape`]).
+    pub const PACKET_W: usize = packet_shape(V::LANES).0;
+    /// Packet height in pixels ([`packet_shape`]).
+    pub const PACKET_H: usize = packet_shape(V::LANES).1;
 
     /// Cuts `rays` (row-major, `width x height`) into packets.
     #[inline(always)]

@@ -174,13 +174,14 @@ fn depth_color(t: f32, near: f32, far: f32) -> [u8; 4] {
     depth_grey(if far > near { (t - near) / (far - near) } else { 0.0 })
 }
 
-/// Width and height of the blocks a method traces as one unit: a ray, a packet (2x2, or 4x2 with eight
-/// lanes), or the whole tile for frustums.
+/// Width and height of the blocks a method traces as one unit: a ray, a packet
+/// ([`crate::packet::packet_shape`]), or the whole tile for frustums.
 fn unit_size(options: &TraceOptions, tile: u32) -> (u32, u32) {
     if options.method.uses_tiles() {
         (tile, tile)
     } else if options.method.uses_packets() {
-        (options.backend.lanes() as u32 / 2, 2)
+        let (w, h) = crate::packet::packet_shape(options.backend.lanes());
+        (w as u32, h as u32)
     } else {
         (1, 1)
     }
