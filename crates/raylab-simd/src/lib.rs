@@ -50,6 +50,11 @@ pub trait Vf32:
     type Mask: VMask;
     /// Number of lanes.
     const LANES: usize;
+    /// `[T; LANES]`: per-lane data kept beside the vectors (a packet's triangle ids, the rays to pack), sized
+    /// for this lane type rather than for the widest, so narrow kernels do not fill and copy unused lanes.
+    type Array<T: Copy + Debug>: Copy + Debug + AsRef<[T]> + AsMut<[T]>;
+    /// The array whose element `i` is `f(i)`.
+    fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> Self::Array<T>;
     /// All lanes set to `x`.
     fn splat(x: f32) -> Self;
     /// Lanes from a slice of exactly `LANES` values.
@@ -299,6 +304,8 @@ mod tests {
             assert_eq!(V::Mask::from_bits(u32::MAX).bits(), all);
             assert_eq!((V::Mask::from_bits(0b0110) ^ V::Mask::from_bits(0b0011)).bits(), 0b0101);
             assert_eq!(V::splat(2.5).lane(n - 1), 2.5);
+            let ids = V::array_from_fn(|i| 10 * i);
+            assert_eq!(ids.as_ref(), (0..n).map(|i| 10 * i).collect::<Vec<_>>().as_slice(), "one element per lane");
             let rows: Vec<[f32; 4]> = (0..16).map(|i| [i as f32, 10.0 + i as f32, -(i as f32), f32::NAN]).collect();
             let refs: Vec<&[f32; 4]> = rows.iter().collect();
             let spread = V::splat_rows(&refs);

@@ -1,5 +1,6 @@
 //! The portable backend: four `f32` lanes in an array, with exactly the SSE backend's semantics.
 
+use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Not, Sub};
 
 use crate::{VMask, Vf32};
@@ -82,6 +83,12 @@ impl F32x4 {
 impl Vf32 for F32x4 {
     type Mask = M32x4;
     const LANES: usize = 4;
+    type Array<T: Copy + Debug> = [T; 4];
+
+    #[inline(always)]
+    fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> [T; 4] {
+        std::array::from_fn(f)
+    }
 
     #[inline(always)]
     fn splat(x: f32) -> Self {

@@ -1,6 +1,7 @@
 //! The SSE2 backend (part of every x86-64 CPU, so no run-time detection is needed for it).
 
 use std::arch::x86_64::*;
+use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Not, Sub};
 
 use crate::{VMask, Vf32};
@@ -89,6 +90,12 @@ arith!(Div, div, _mm_div_ps);
 impl Vf32 for F32x4 {
     type Mask = M32x4;
     const LANES: usize = 4;
+    type Array<T: Copy + Debug> = [T; 4];
+
+    #[inline(always)]
+    fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> [T; 4] {
+        std::array::from_fn(f)
+    }
 
     #[inline(always)]
     fn splat(x: f32) -> Self {

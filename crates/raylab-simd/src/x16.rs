@@ -8,6 +8,7 @@
 //! (`__mmask16`), so a comparison's lanes are its bits with no conversion.
 
 use std::arch::x86_64::*;
+use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Not, Sub};
 
 use crate::{VMask, Vf32};
@@ -120,6 +121,12 @@ impl F32x16 {
 impl Vf32 for F32x16 {
     type Mask = M32x16;
     const LANES: usize = 16;
+    type Array<T: Copy + Debug> = [T; 16];
+
+    #[inline(always)]
+    fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> [T; 16] {
+        std::array::from_fn(f)
+    }
 
     #[inline(always)]
     fn splat(x: f32) -> Self {

@@ -8,6 +8,7 @@
 //! which is compiled for AVX2, so every operation becomes one 256-bit instruction.
 
 use std::arch::x86_64::*;
+use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Not, Sub};
 
 use crate::{VMask, Vf32};
@@ -102,6 +103,12 @@ impl F32x8 {
 impl Vf32 for F32x8 {
     type Mask = M32x8;
     const LANES: usize = 8;
+    type Array<T: Copy + Debug> = [T; 8];
+
+    #[inline(always)]
+    fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> [T; 8] {
+        std::array::from_fn(f)
+    }
 
     #[inline(always)]
     fn splat(x: f32) -> Self {

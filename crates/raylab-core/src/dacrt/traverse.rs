@@ -76,8 +76,8 @@ impl Answer for Closest<'_> {
                 intersect_packet(&p, &mut hits, soup.get(t.id), t.id, p.valid);
             }
             let found = hits.to_hits();
-            for (r, h) in group.iter_mut().zip(found) {
-                let Some(h) = h else { continue };
+            for (r, h) in group.iter_mut().zip(found.as_ref()) {
+                let &Some(h) = h else { continue };
                 let best = &mut self.out[r.id as usize];
                 if beats(&h, *best) {
                     *best = Some(h);

@@ -341,7 +341,7 @@ impl Mbvh {
             }
             let found = hits.to_hits();
             for (k, &id) in group.iter().enumerate() {
-                if let Some(h) = found[k] {
+                if let Some(h) = found.as_ref()[k] {
                     *hot[id as usize].best_mut() = h.t;
                     slots[id as usize].hit = Some(h);
                 }

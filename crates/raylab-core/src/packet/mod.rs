@@ -64,18 +64,19 @@ impl<V: Vf32> RayPacket<V> {
     #[inline(always)]
     pub fn gather(ray: impl Fn(usize) -> Option<Ray>) -> Self {
         const EMPTY: [[f32; 4]; 2] = [[0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, f32::INFINITY]];
-        let mut rows = [EMPTY; MAX_LANES];
+        let mut rows = V::array_from_fn(|_| EMPTY);
         let mut present = 0u32;
-        for (i, row) in rows.iter_mut().enumerate().take(V::LANES) {
+        for (i, row) in rows.as_mut().iter_mut().enumerate() {
             if let Some(r) = ray(i) {
                 present |= 1 << i;
                 *row = [[r.origin.x, r.origin.y, r.origin.z, r.dir.x], [r.dir.y, r.dir.z, r.tmin, r.tmax]];
             }
         }
-        let first: [&[f32; 4]; MAX_LANES] = std::array::from_fn(|i| &rows[i][0]);
-        let second: [&[f32; 4]; MAX_LANES] = std::array::from_fn(|i| &rows[i][1]);
-        let [ox, oy, oz, dx] = V::transpose_rows(&first);
-        let [dy, dz, tmin, tmax] = V::transpose_rows(&second);
+        let rows = rows.as_ref();
+        let first = V::array_from_fn(|i| &rows[i][0]);
+        let second = V::array_from_fn(|i| &rows[i][1]);
+        let [ox, oy, oz, dx] = V::transpose_rows(first.as_ref());
+        let [dy, dz, tmin, tmax] = V::transpose_rows(second.as_ref());
         // `Ray::is_valid` per lane: finite origin and direction (`|x| < inf` fails for infinities and NaN), a
         // non-zero direction, no NaN interval end.
         let (zero, inf) = (V::splat(0.0), V::splat(f32::INFINITY));
@@ -191,7 +192,7 @@ pub struct PacketHits<V: Vf32> {
     /// Barycentric weight of vertex 2.
     pub v: V,
     /// Triangle id per lane (`u32::MAX` where nothing was hit).
-    pub tri: [u32; MAX_LANES],
+    pub tri: V::Array<u32>,
     /// Lanes that hit something.
     pub hit: V::Mask,
 }
@@ -200,18 +201,31 @@ impl<V: Vf32> PacketHits<V> {
     /// No hits yet: `t` starts at each ray's `tmax`.
     #[inline(always)]
     pub fn new(p: &RayPacket<V>) -> Self {
-        Self { t: p.tmax, u: V::splat(0.0), v: V::splat(0.0), tri: [u32::MAX; MAX_LANES], hit: V::Mask::from_bits(0) }
+        Self {
+            t: p.tmax,
+            u: V::splat(0.0),
+            v: V::splat(0.0),
+            tri: V::array_from_fn(|_| u32::MAX),
+            hit: V::Mask::from_bits(0),
+        }
     }
 
     /// The hits of all lanes at once (cheaper than [`PacketHits::get`] per lane).
     #[inline(always)]
-    pub fn to_hits(&self) -> [Option<Hit>; MAX_LANES] {
-        let (mut t, mut u, mut v) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
-        self.t.write_to(&mut t[..V::LANES]);
-        self.u.write_to(&mut u[..V::LANES]);
-        self.v.write_to(&mut v[..V::LANES]);
+    pub fn to_hits(&self) -> V::Array<Option<Hit>> {
+        let (mut t, mut u, mut v) = (V::array_from_fn(|_| 0.0), V::array_from_fn(|_| 0.0), V::array_from_fn(|_| 0.0));
+        self.t.write_to(t.as_mut());
+        self.u.write_to(u.as_mut());
+        self.v.write_to(v.as_mut());
+        let (t, u, v, tri) = (t.as_ref(), u.as_ref(), v.as_ref(), self.tri.as_ref());
         let bits = self.hit.bits();
-        std::array::from_fn(|i| (bits >> i & 1 == 1).then(|| Hit { t: t[i], tri: self.tri[i], u: u[i], v: v[i] }))
+        let mut out = V::array_from_fn(|_| None);
+        for (i, h) in out.as_mut().iter_mut().enumerate() {
+            if bits >> i & 1 == 1 {
+                *h = Some(Hit { t: t[i], tri: tri[i], u: u[i], v: v[i] });
+            }
+        }
+        out
     }
 
     /// The hit of lane `i`.
@@ -219,7 +233,7 @@ impl<V: Vf32> PacketHits<V> {
     pub fn get(&self, i: usize) -> Option<Hit> {
         (self.hit.bits() >> i & 1 == 1).then(|| Hit {
             t: self.t.lane(i),
-            tri: self.tri[i],
+            tri: self.tri.as_ref()[i],
             u: self.u.lane(i),
             v: self.v.lane(i),
         })

@@ -140,7 +140,7 @@ pub fn intersect_packet<V: Vf32>(
         hits.v = V::select(r.mask, r.v, hits.v);
         hits.hit = hits.hit | r.mask;
         let bits = r.mask.bits();
-        for (i, slot) in hits.tri.iter_mut().enumerate().take(V::LANES) {
+        for (i, slot) in hits.tri.as_mut().iter_mut().enumerate() {
             if bits >> i & 1 == 1 {
                 *slot = id;
             }

@@ -368,7 +368,7 @@ impl<'a> Tracer<'a> {
         }
         for (j, hits) in tile.hits.iter().enumerate() {
             let lanes = hits.to_hits();
-            tile.for_each_lane(j, |pixel, lane| out[pixel] = lanes[lane]);
+            tile.for_each_lane(j, |pixel, lane| out[pixel] = lanes.as_ref()[lane]);
         }
     }
 
