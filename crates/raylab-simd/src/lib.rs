@@ -55,6 +55,10 @@ pub trait Vf32:
     type Array<T: Copy + Debug>: Copy + Debug + AsRef<[T]> + AsMut<[T]>;
     /// The array whose element `i` is `f(i)`.
     fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> Self::Array<T>;
+    /// The four-lane type of this backend, for work that is four-wide whatever the packet width (MFT's four
+    /// frustums): narrower registers make a lighter stack entry and, where wide operations are split into
+    /// halves, cheaper steps.
+    type Quad: Vf32;
     /// All lanes set to `x`.
     fn splat(x: f32) -> Self;
     /// Lanes from a slice of exactly `LANES` values.

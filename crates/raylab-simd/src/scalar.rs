@@ -84,6 +84,7 @@ impl Vf32 for F32x4 {
     type Mask = M32x4;
     const LANES: usize = 4;
     type Array<T: Copy + Debug> = [T; 4];
+    type Quad = Self;
 
     #[inline(always)]
     fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> [T; 4] {

@@ -122,6 +122,7 @@ impl Vf32 for F32x16 {
     type Mask = M32x16;
     const LANES: usize = 16;
     type Array<T: Copy + Debug> = [T; 16];
+    type Quad = crate::sse::F32x4;
 
     #[inline(always)]
     fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> [T; 16] {

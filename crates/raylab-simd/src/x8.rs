@@ -104,6 +104,7 @@ impl Vf32 for F32x8 {
     type Mask = M32x8;
     const LANES: usize = 8;
     type Array<T: Copy + Debug> = [T; 8];
+    type Quad = crate::sse::F32x4;
 
     #[inline(always)]
     fn array_from_fn<T: Copy + Debug>(f: impl FnMut(usize) -> T) -> [T; 8] {

@@ -5,7 +5,8 @@
 //! as for one large frustum; but a frustum that does not reach a child, or whose rays have all hit before
 //! the child's interval starts ("completed"), is masked out there, and its packets skip that child's
 //! leaves. The active mask is pushed with every stack entry. The per-lane interval update is the scalar
-//! one of [`super::frustum`], done for four frustums at once.
+//! one of [`super::frustum`], done for four frustums at once, in the backend's four-lane vectors
+//! ([`Vf32::Quad`]) whatever the width of the packets.
 
 use raylab_simd::{VMask, Vf32};
 
@@ -13,33 +14,36 @@ use super::frustum::{BatchBits, Leaf, front_child, hit_limit, leaf_intersect, le
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::coord;
-use crate::packet::{Bundle, MAX_LANES, PacketTile, bundle_lanes, map3};
+use crate::packet::{Bundle, PacketTile, bundle_lanes, map3};
 use crate::stats::TraversalStats;
 
+/// The four-lane vectors of the frustum lanes when packets have `V`'s width.
+type Q<V> = <V as Vf32>::Quad;
+
 /// Four bundles (pyramid frustums or cones) with a common origin, one per SIMD lane, each through its
-/// per-sign crossing factors.
+/// per-sign crossing factors, for the packets of a tile in `V`.
 #[derive(Clone, Copy, Debug)]
 pub struct Frustum4<V: Vf32> {
     origin: glam::Vec3,
-    pos_near: [V; 3],
-    pos_far: [V; 3],
-    neg_near: [V; 3],
-    neg_far: [V; 3],
-    t_min: V,
-    t_max: V,
+    pos_near: [Q<V>; 3],
+    pos_far: [Q<V>; 3],
+    neg_near: [Q<V>; 3],
+    neg_far: [Q<V>; 3],
+    t_min: Q<V>,
+    t_max: Q<V>,
     origin_slack: f32,
     /// Lanes that hold a bundle.
-    valid: V::Mask,
+    valid: <Q<V> as Vf32>::Mask,
 }
 
 impl<V: Vf32> Frustum4<V> {
     /// Packs up to four bundles with the same origin; `None` entries leave a lane empty.
     #[inline(always)]
     pub fn new<B: Bundle>(f: [Option<B>; 4]) -> Option<Self> {
-        assert!(V::LANES >= 4, "MFT traces four bundles");
+        assert_eq!(Q::<V>::LANES, 4, "MFT traces four bundles");
         let origin = f.iter().flatten().next()?.origin();
         assert!(f.iter().flatten().all(|x| x.origin() == origin), "MFT bundles share their origin");
-        let lanes = |g: &dyn Fn(&B) -> f32, empty: f32| bundle_lanes::<V, _>(&f, g, empty);
+        let lanes = |g: &dyn Fn(&B) -> f32, empty: f32| bundle_lanes::<Q<V>, _>(&f, g, empty);
         let axes = |g: &dyn Fn(&B, usize) -> f32, empty: f32| map3([0, 1, 2], |k| lanes(&|x: &B| g(x, k), empty));
         let valid = f.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
         Some(Self {
@@ -51,23 +55,23 @@ impl<V: Vf32> Frustum4<V> {
             t_min: lanes(&|x| x.t_range().0, f32::INFINITY),
             t_max: lanes(&|x| x.t_range().1, f32::NEG_INFINITY),
             origin_slack: f.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack())),
-            valid: V::Mask::from_bits(valid),
+            valid: <Q<V> as Vf32>::Mask::from_bits(valid),
         })
     }
 
     /// Per lane, the range of distances at which the bundle crosses `coordinate k = split`: the scalar
     /// [`Bundle::crossing`] in every lane, with one branch on the side of the shared origin.
     #[inline(always)]
-    fn crossing(&self, k: usize, split: f32) -> (V, V) {
+    fn crossing(&self, k: usize, split: f32) -> (Q<V>, Q<V>) {
         let (dist, slack) = (split - coord(&self.origin, k), self.origin_slack);
         let [pos_near, pos_far, neg_near, neg_far] =
             [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]];
         if dist > slack {
-            (V::splat(dist - slack) * pos_near, V::splat(dist + slack) * pos_far)
+            (Q::<V>::splat(dist - slack) * pos_near, Q::<V>::splat(dist + slack) * pos_far)
         } else if dist < -slack {
-            (V::splat(dist + slack) * neg_near, V::splat(dist - slack) * neg_far)
+            (Q::<V>::splat(dist + slack) * neg_near, Q::<V>::splat(dist - slack) * neg_far)
         } else {
-            (V::splat(0.0), V::splat(f32::INFINITY))
+            (Q::<V>::splat(0.0), Q::<V>::splat(f32::INFINITY))
         }
     }
 }
@@ -76,7 +80,7 @@ impl<V: Vf32> Frustum4<V> {
 trait MftLeaf<V: Vf32> {
     /// Tests `leaf` for the frustum lanes in `active` (bits), whose intervals start at `near`; returns each
     /// lane's distance limit and the lanes that are finished.
-    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32);
+    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32);
 }
 
 /// Closest hits: `limit[i]` is the farthest current hit of frustum `i`'s packets.
@@ -84,12 +88,12 @@ struct ClosestLeaves<'a, V: Vf32> {
     tile: &'a mut PacketTile<V>,
     sets: &'a [Vec<usize>; 4],
     cull: bool,
-    limit: [f32; MAX_LANES],
+    limit: [f32; 4],
 }
 
 impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
     #[inline(always)]
-    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32) {
+    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32) {
         // One set of batched verdicts for the four frustums: their packets share chunks.
         let batch = &mut BatchBits::<4>::default();
         for (i, set) in self.sets.iter().enumerate() {
@@ -98,7 +102,7 @@ impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
                 self.limit[i] = hit_limit(self.tile, set);
             }
         }
-        (V::from_slice(&self.limit[..V::LANES]), 0)
+        (Q::<V>::from_slice(&self.limit), 0)
     }
 }
 
@@ -115,7 +119,7 @@ struct BlockedLeaves<'a, V: Vf32> {
 
 impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
     #[inline(always)]
-    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (V, u32) {
+    fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32) {
         let batch = &mut BatchBits::<4>::default();
         for (i, set) in self.sets.iter().enumerate() {
             if active >> i & 1 == 1 {
@@ -126,16 +130,17 @@ impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
                 }
             }
         }
-        (V::splat(f32::INFINITY), self.done)
+        (Q::<V>::splat(f32::INFINITY), self.done)
     }
 }
 
+/// A pending child: its node, the four frustums' intervals there and the frustums that reach it.
 #[derive(Clone, Copy)]
-struct Entry<V: Vf32> {
+struct Entry<Q: Vf32> {
     node: u32,
-    near: V,
-    far: V,
-    active: V::Mask,
+    near: Q,
+    far: Q,
+    active: Q::Mask,
 }
 
 const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
@@ -151,7 +156,7 @@ impl KdTree {
         cull: bool,
         stats: &mut TraversalStats,
     ) {
-        self.traverse_mft(f, stats, &mut ClosestLeaves { tile, sets, cull, limit: [f32::INFINITY; MAX_LANES] });
+        self.traverse_mft(f, stats, &mut ClosestLeaves { tile, sets, cull, limit: [f32::INFINITY; 4] });
     }
 
     /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` lists the packets
@@ -182,16 +187,17 @@ impl KdTree {
         if self.triangles().is_empty() || f.valid.none() {
             return;
         }
-        let lo_slack = V::splat(1.0 - SPLIT_SLACK);
-        let hi_slack = V::splat(1.0 + SPLIT_SLACK);
+        type M<V> = <Q<V> as Vf32>::Mask;
+        let lo_slack = Q::<V>::splat(1.0 - SPLIT_SLACK);
+        let hi_slack = Q::<V>::splat(1.0 + SPLIT_SLACK);
         let nodes = self.nodes();
-        let zero = V::splat(0.0);
-        let mut stack = [Entry { node: 0, near: zero, far: zero, active: V::Mask::from_bits(0) }; STACK];
+        let zero = Q::<V>::splat(0.0);
+        let mut stack = [Entry { node: 0, near: zero, far: zero, active: M::<V>::from_bits(0) }; STACK];
         let mut sp = 0usize;
         let (t_min, t_max, origin) = (f.t_min, f.t_max, f.origin);
         let (mut node, mut near, mut far) = (0usize, t_min, t_max);
         let mut active = f.valid;
-        let mut done = V::Mask::from_bits(0);
+        let mut done = M::<V>::from_bits(0);
         let (mut visited, mut leaves) = (0u64, 0u64);
         'walk: loop {
             let n = nodes[node];
@@ -217,13 +223,12 @@ impl KdTree {
                 continue;
             }
             leaves += 1;
-            let mut near_lanes = [0.0f32; MAX_LANES];
-            near.write_to(&mut near_lanes[..V::LANES]);
-            let near4 = std::array::from_fn(|i| near_lanes[i]);
+            let mut near4 = [0.0f32; 4];
+            near.write_to(&mut near4);
             // Each frustum lane has its own entry distance: the visitor sets `near` from `near4` per lane.
             let leaf_at = Leaf { tree: self, node: n, near: 0.0 };
             let (limit, finished) = leaf.visit(&leaf_at, near4, (active & !done).bits(), stats);
-            done = done | V::Mask::from_bits(finished);
+            done = done | M::<V>::from_bits(finished);
             if (f.valid & !done).none() {
                 break;
             }
