@@ -113,8 +113,13 @@ pub fn render_pass(
         Pass { scene, tracer, raster: camera.raster(w, h), light, settings, pass, epsilon: surface_epsilon(scene) };
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
-    let done: Vec<TileResult> =
-        tiles.par_iter().map(|&(x0, y0)| ctx.tile(x0, y0, tile.min(w - x0), tile.min(h - y0))).collect();
+    // One tile per job, so that the threads share out the costly parts of the image (see
+    // `render::TILES_PER_JOB`).
+    let done: Vec<TileResult> = tiles
+        .par_iter()
+        .with_max_len(1)
+        .map(|&(x0, y0)| ctx.tile(x0, y0, tile.min(w - x0), tile.min(h - y0)))
+        .collect();
     let mut per_bounce = vec![BounceStats::default(); settings.bounces as usize + 1];
     for (pixels, bounces) in done {
         for (i, c) in pixels {

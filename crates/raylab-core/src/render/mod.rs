@@ -122,9 +122,11 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
     };
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
-    // Each worker's scratch buffers serve tile after tile, so a frame allocates them a few times, not per tile.
+    // Jobs of at most `TILES_PER_JOB` tiles, so that the threads share out the expensive parts of the image;
+    // each job's scratch buffers serve its tiles.
     let done: Vec<TileOut> = tiles
         .par_iter()
+        .with_max_len(TILES_PER_JOB)
         .map_init(Scratch::default, |sc, &(x0, y0)| ctx.tile(x0, y0, tile.min(w - x0), tile.min(h - y0), sc))
         .collect();
 
@@ -186,6 +188,13 @@ fn unit_size(options: &TraceOptions, tile: u32) -> (u32, u32) {
         (1, 1)
     }
 }
+
+/// Most tiles a rayon job renders. Left to itself, rayon cuts a frame's tiles into about two pieces per thread
+/// and only splits a piece further once another thread steals it; the parts of an image cost very different
+/// amounts (sky against arcades), so one thread was left finishing a costly quarter alone. Small jobs share
+/// the work evenly (Sponza 512x512, MFT 16, hard shadows, two threads: 27.1 to 24.3 ms a frame), while
+/// still amortising each job's scratch buffers over a few tiles (one tile per job: 25.4 ms).
+pub const TILES_PER_JOB: usize = 4;
 
 /// Everything a tile needs, shared by all tiles of a frame.
 struct TileContext<'a> {
