@@ -192,9 +192,10 @@ fn unit_size(options: &TraceOptions, tile: u32) -> (u32, u32) {
 /// Most tiles a rayon job renders. Left to itself, rayon cuts a frame's tiles into about two pieces per thread
 /// and only splits a piece further once another thread steals it; the parts of an image cost very different
 /// amounts (sky against arcades), so one thread was left finishing a costly quarter alone. Small jobs share
-/// the work evenly (Sponza 512x512, MFT 16, hard shadows, two threads: 27.1 to 24.3 ms a frame), while
-/// still amortising each job's scratch buffers over a few tiles (one tile per job: 25.4 ms).
-pub const TILES_PER_JOB: usize = 4;
+/// the work evenly (Sponza 512x512, MFT 16, two threads, mean of 8 frames: hard shadows 28.0 to 24.8 ms,
+/// edge widths 29.9 to 26.9), while each job's scratch buffers (the edge-width walks' states among them)
+/// still serve several tiles: with four tiles per job the edge-width frames gained less (27.5 ms).
+pub const TILES_PER_JOB: usize = 16;
 
 /// Everything a tile needs, shared by all tiles of a frame.
 struct TileContext<'a> {
