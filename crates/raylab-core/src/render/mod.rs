@@ -16,6 +16,7 @@ pub use stages::StageTimes;
 pub use view::{FrameView, depth_grey, heat_color};
 pub use visibility::{ShadowScratch, ShadowTracer};
 
+use std::cell::RefCell;
 use std::time::Instant;
 
 use glam::Vec3;
@@ -122,12 +123,14 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
     };
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
-    // Jobs of at most `TILES_PER_JOB` tiles, so that the threads share out the expensive parts of the image;
-    // each job's scratch buffers serve its tiles.
+    // One tile per rayon job. Left to itself, rayon cuts a frame's tiles into about two pieces per thread and
+    // splits a piece further only once another thread steals it; the parts of an image cost very different
+    // amounts (sky against arcades, lit floor against shadow edges), so one thread was left finishing a
+    // costly piece alone. The scratch buffers stay with the worker thread instead of the job.
     let done: Vec<TileOut> = tiles
         .par_iter()
-        .with_max_len(TILES_PER_JOB)
-        .map_init(Scratch::default, |sc, &(x0, y0)| ctx.tile(x0, y0, tile.min(w - x0), tile.min(h - y0), sc))
+        .with_max_len(1)
+        .map(|&(x0, y0)| with_scratch(|sc| ctx.tile(x0, y0, tile.min(w - x0), tile.min(h - y0), sc)))
         .collect();
 
     let mut rgba = vec![[0, 0, 0, 255]; (w * h) as usize];
@@ -189,13 +192,19 @@ fn unit_size(options: &TraceOptions, tile: u32) -> (u32, u32) {
     }
 }
 
-/// Most tiles a rayon job renders. Left to itself, rayon cuts a frame's tiles into about two pieces per thread
-/// and only splits a piece further once another thread steals it; the parts of an image cost very different
-/// amounts (sky against arcades), so one thread was left finishing a costly quarter alone. Small jobs share
-/// the work evenly (Sponza 512x512, MFT 16, two threads, mean of 8 frames: hard shadows 28.0 to 24.8 ms,
-/// edge widths 29.9 to 26.9), while each job's scratch buffers (the edge-width walks' states among them)
-/// still serve several tiles: with four tiles per job the edge-width frames gained less (27.5 ms).
-pub const TILES_PER_JOB: usize = 16;
+thread_local! {
+    /// Each rayon worker's tile scratch buffers, kept from tile to tile and frame to frame.
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// Runs `f` with this thread's tile scratch, or with fresh buffers when they are in use: a thread that waits
+/// inside a tile's own parallel work (DACRT's joins) may be handed another tile meanwhile.
+fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
+    SCRATCH.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut sc) => f(&mut sc),
+        Err(_) => f(&mut Scratch::default()),
+    })
+}
 
 /// Everything a tile needs, shared by all tiles of a frame.
 struct TileContext<'a> {

@@ -114,7 +114,8 @@ impl ShadowTracer<'_> {
                 // A segment nothing blocks has no crossing and a visibility of 1: the frame's method finds
                 // those as hard shadows, coherently, and only the blocked ones walk the tree for edge widths.
                 self.hard(surfaces, (width, height), stats, sc);
-                if sc.edge.is_empty() {
+                // Scratch outlives frames (see `render`), whose edge settings may differ.
+                if sc.edge.first().is_none_or(|e| e.settings() != (radius, leak_fix)) {
                     sc.edge = vec![EdgeWidth::new(radius, leak_fix); MAX_LANES];
                 }
                 sc.walks.clear();

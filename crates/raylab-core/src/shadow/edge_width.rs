@@ -51,6 +51,11 @@ impl EdgeWidth {
         Self { radius, leak_fix, ..Self::default() }
     }
 
+    /// The edge width and light-leak switch this state was made for.
+    pub fn settings(&self) -> (f32, bool) {
+        (self.radius, self.leak_fix)
+    }
+
     /// Resets the state for a new ray, keeping the buffers.
     pub fn begin(&mut self) {
         self.pending.clear();
