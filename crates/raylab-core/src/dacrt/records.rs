@@ -8,7 +8,6 @@ use glam::{Vec3, Vec4};
 use raylab_simd::Vf32;
 
 use crate::aabb::Aabb;
-use crate::packet::MAX_LANES;
 use crate::ray::Ray;
 
 /// A ray as DACRT stores it: 48 bytes, moved (not indexed) by every filter pass. Its three 16-byte rows
@@ -48,11 +47,8 @@ impl RayRecord {
 /// block repeats its first ray in the missing lanes.
 #[inline(always)]
 pub(super) fn row_lanes<V: Vf32>(block: &[RayRecord], i: usize) -> [V; 4] {
-    let mut rs = [&block[0].rows()[i]; MAX_LANES];
-    for (k, r) in rs.iter_mut().enumerate().take(V::LANES) {
-        *r = &block[k.min(block.len() - 1)].rows()[i];
-    }
-    V::transpose_rows(&rs)
+    let rs = V::array_from_fn(|k| &block[k.min(block.len() - 1)].rows()[i]);
+    V::transpose_rows(rs.as_ref())
 }
 
 /// A triangle as DACRT moves it: its box and its id in the scene (32 bytes). Division, which every set pays

@@ -10,7 +10,7 @@ use super::partition::partition;
 use super::records::{RayRecord, SetBounds, TriRecord, row_lanes};
 use super::split::divide;
 use super::{DacrtParams, TopNode};
-use crate::packet::{MAX_LANES, PacketHits, RayPacket, intersect_packet, occlude_packet};
+use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
 use crate::ray::Hit;
 use crate::stats::TraversalStats;
 use crate::triangle::TriangleSoup;
@@ -90,14 +90,14 @@ impl Answer for Closest<'_> {
 
 /// The lanes of packet `p` that some triangle of `tris` blocks, and for each lane the first such triangle.
 #[inline(always)]
-fn blocked<V: Vf32>(p: &RayPacket<V>, soup: &TriangleSoup, tris: &[TriRecord]) -> (u32, [u32; MAX_LANES]) {
+fn blocked<V: Vf32>(p: &RayPacket<V>, soup: &TriangleSoup, tris: &[TriRecord]) -> (u32, V::Array<u32>) {
     let mut open = p.valid;
-    let mut first = [u32::MAX; MAX_LANES];
+    let mut first = V::array_from_fn(|_| u32::MAX);
     for t in tris {
         let hit = occlude_packet(p, soup.get(t.id), open);
         if hit.any() {
             let bits = hit.bits();
-            for (k, f) in first.iter_mut().enumerate() {
+            for (k, f) in first.as_mut().iter_mut().enumerate() {
                 if bits >> k & 1 == 1 {
                     *f = t.id;
                 }
@@ -143,7 +143,7 @@ impl Answer for Blocker<'_> {
             let (bits, first) = blocked(&packet::<V>(group), soup, tris);
             for (k, r) in group.iter_mut().enumerate() {
                 if bits >> k & 1 == 1 {
-                    self.out[r.id as usize] = Some(first[k]);
+                    self.out[r.id as usize] = Some(first.as_ref()[k]);
                     r.tmax = f32::NEG_INFINITY;
                 }
             }

@@ -113,8 +113,7 @@ pub fn render_pass(
         Pass { scene, tracer, raster: camera.raster(w, h), light, settings, pass, epsilon: surface_epsilon(scene) };
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
-    // One tile per job, so that the threads share out the costly parts of the image (see
-    // `render::TILES_PER_JOB`).
+    // One tile per job, so that the threads share out the costly parts of the image (as `render` does).
     let done: Vec<TileResult> = tiles
         .par_iter()
         .with_max_len(1)

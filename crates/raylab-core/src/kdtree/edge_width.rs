@@ -16,7 +16,7 @@ use std::ops::Range;
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use crate::packet::{MAX_LANES, RayPacket, crossing_packet};
+use crate::packet::{RayPacket, crossing_packet};
 use crate::ray::Ray;
 use crate::shadow::{Crossing, EdgeWidth};
 use crate::stats::TraversalStats;
@@ -78,11 +78,7 @@ impl KdTree {
                 end += 1;
             }
             let group = &order[start..end];
-            let mut lanes = [None; MAX_LANES];
-            for (lane, &(i, _)) in lanes.iter_mut().zip(group) {
-                *lane = Some(rays[i]);
-            }
-            let p = RayPacket::<V>::new(&lanes[..V::LANES]);
+            let p = RayPacket::<V>::gather(|lane| group.get(lane).map(|&(i, _)| rays[i]));
             let states = &mut states[..group.len()];
             for s in states.iter_mut() {
                 s.begin();
@@ -116,7 +112,7 @@ impl<V: Vf32> PacketLeaf<V> for EdgeWalks<'_, V> {
     #[inline(always)]
     fn visit(&mut self, ids: Range<usize>, active: V::Mask, t_far: V) -> (V, V::Mask) {
         let tris = self.tree.triangles();
-        let mut t = [0.0f32; MAX_LANES];
+        let mut t = V::array_from_fn(|_| 0.0);
         for &id in &self.tree.tri_ids()[ids] {
             self.tests += 1;
             let corners = tris.get(id);
@@ -124,7 +120,7 @@ impl<V: Vf32> PacketLeaf<V> for EdgeWalks<'_, V> {
             if hit.none() {
                 continue;
             }
-            t_hit.write_to(&mut t[..V::LANES]);
+            t_hit.write_to(t.as_mut());
             let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
             let mut bits = hit.bits();
             while bits != 0 {
@@ -133,7 +129,7 @@ impl<V: Vf32> PacketLeaf<V> for EdgeWalks<'_, V> {
                 let state = &mut self.states[i];
                 if !state.seen(id) {
                     let dir = Vec3::new(self.p.dir[0].lane(i), self.p.dir[1].lane(i), self.p.dir[2].lane(i));
-                    state.add(Crossing { t: t[i], tri: id, front: n.dot(dir) < 0.0 });
+                    state.add(Crossing { t: t.as_ref()[i], tri: id, front: n.dot(dir) < 0.0 });
                     self.pending |= 1 << i;
                 }
             }
@@ -141,8 +137,9 @@ impl<V: Vf32> PacketLeaf<V> for EdgeWalks<'_, V> {
         let mut finished = 0u32;
         let mut bits = active.bits() & self.pending;
         if bits != 0 {
-            let mut far = [0.0f32; MAX_LANES];
-            t_far.write_to(&mut far[..V::LANES]);
+            let mut far = V::array_from_fn(|_| 0.0);
+            t_far.write_to(far.as_mut());
+            let far = far.as_ref();
             while bits != 0 {
                 let i = bits.trailing_zeros() as usize;
                 bits &= bits - 1;

@@ -175,11 +175,11 @@ pub(crate) fn map3<T: Copy, U>(a: [T; 3], f: impl Fn(T) -> U) -> [U; 3] {
 /// and where a bundle is missing.
 #[inline(always)]
 pub(crate) fn bundle_lanes<V: Vf32, B>(bundles: &[Option<B>; 4], field: &dyn Fn(&B) -> f32, empty: f32) -> V {
-    let mut a = [empty; MAX_LANES];
-    for (lane, b) in a.iter_mut().zip(bundles) {
+    let mut a = V::array_from_fn(|_| empty);
+    for (lane, b) in a.as_mut().iter_mut().zip(bundles) {
         *lane = b.as_ref().map_or(empty, field);
     }
-    V::from_slice(&a[..V::LANES])
+    V::from_slice(a.as_ref())
 }
 
 /// Closest hits of a packet, per lane.
