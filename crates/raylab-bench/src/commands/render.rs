@@ -85,6 +85,13 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         frame.stats.rays as f64 / render_s / 1e6,
         frame.stats.nodes_per_ray(),
     );
+    let stages: Vec<String> = raylab_core::render::StageTimes::NAMES
+        .iter()
+        .zip(frame.stages.as_array())
+        .filter(|&(_, t)| t > 0.0)
+        .map(|(name, t)| format!("{name} {:.1} ms", t * 1e3))
+        .collect();
+    println!("stages (summed over threads): {}", stages.join(", "));
     let shown = std::fs::canonicalize(&a.out).unwrap_or_else(|_| a.out.clone());
     println!("wrote {}", shown.display());
     Ok(())

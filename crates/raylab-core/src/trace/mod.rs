@@ -380,9 +380,13 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// [`Tracer::occluded_tile`] for the methods that trace packets, with lane type `V` and the buffers of
+    /// `scratch`: kernels that trace many small tiles in one dispatch reuse them.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn occluded_simd<V: Vf32>(
+    pub(crate) fn occluded_simd<V: Vf32>(
         &self,
+        scratch: &mut TileScratch<V>,
         rays: &[Option<Ray>],
         width: usize,
         height: usize,
@@ -390,62 +394,76 @@ impl<'a> Tracer<'a> {
         out: &mut [bool],
         stats: &mut TraversalStats,
     ) {
-        let mut tile = PacketTile::<V>::new(rays, width, height);
-        let mut blocked = vec![V::Mask::from_bits(0); tile.packets.len()];
-        let all: Vec<usize> = (0..tile.packets.len()).collect();
+        let TileScratch { tile, all, blocked, stack } = scratch;
+        tile.refill(rays, width, height);
+        let tile = &mut *tile;
+        blocked.clear();
+        blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
+        all.clear();
+        all.extend(0..tile.packets.len());
+        let all = &all[..];
         if self.options.cull
             && self.options.method.is_bundled()
-            && let Some(origin) = common_origin(&tile, &all)
+            && let Some(origin) = common_origin(tile, all)
         {
             tile.share_origin(origin);
         }
+        let tile = &*tile;
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         let limit = self.options.shadow_spread_limit;
-        // Packets no bundle covers are traced as packets afterwards.
-        let mut leftover: Option<Vec<usize>> = None;
+        // Packets no bundle covers are traced as packets afterwards: all of them, or the quadrants' rest.
+        let mut rest: Option<Vec<usize>> = None;
+        let mut all_left = false;
         match self.options.method {
             Method::Frustum => {
-                let whole =
-                    Bundled { tile: &tile, set: &all, rays: RayRect { rays, width, x: 0..width, y: 0..height } };
-                match common_origin_frustum(&tile, &all)
-                    .or_else(|| toward.and_then(|t| toward_frustum(&whole, t, limit)))
-                {
-                    Some(f) => self.tree.occluded_frustum(&f, &tile, &all, self.options.cull, &mut blocked, stats),
-                    None => leftover = Some(all.clone()),
+                let whole = Bundled { tile, set: all, rays: RayRect { rays, width, x: 0..width, y: 0..height } };
+                // `match`es, not `Option::or_else`: the compiler may keep a closure's vector code out of line.
+                let bundle = match (common_origin_frustum(tile, all), toward) {
+                    (Some(f), _) => Some(f),
+                    (None, Some(t)) => toward_frustum(&whole, t, limit),
+                    (None, None) => None,
+                };
+                match bundle {
+                    Some(f) => self.tree.occluded_frustum(&f, tile, all, self.options.cull, blocked, stats),
+                    None => all_left = true,
                 }
             }
             Method::Cone => {
-                let whole =
-                    Bundled { tile: &tile, set: &all, rays: RayRect { rays, width, x: 0..width, y: 0..height } };
-                match common_origin_cone(&tile, &all).or_else(|| toward.and_then(|t| toward_cone(&whole, t, limit))) {
-                    Some(c) => self.tree.occluded_frustum(&c, &tile, &all, self.options.cull, &mut blocked, stats),
-                    None => leftover = Some(all.clone()),
+                let whole = Bundled { tile, set: all, rays: RayRect { rays, width, x: 0..width, y: 0..height } };
+                let bundle = match (common_origin_cone(tile, all), toward) {
+                    (Some(c), _) => Some(c),
+                    (None, Some(t)) => toward_cone(&whole, t, limit),
+                    (None, None) => None,
+                };
+                match bundle {
+                    Some(c) => self.tree.occluded_frustum(&c, tile, all, self.options.cull, blocked, stats),
+                    None => all_left = true,
                 }
             }
-            Method::Mft => match self.quadrants(&tile, rays, toward, common_origin_frustum, toward_frustum) {
-                Some((b, sets, rest)) => {
+            Method::Mft => match self.quadrants(tile, rays, toward, common_origin_frustum, toward_frustum) {
+                Some((b, sets, left)) => {
                     if let Some(f4) = Frustum4::new(b) {
-                        self.tree.occluded_mft(&f4, &tile, &sets, self.options.cull, &mut blocked, stats);
+                        self.tree.occluded_mft(&f4, tile, &sets, self.options.cull, blocked, stats);
                     }
-                    leftover = Some(rest);
+                    rest = Some(left);
                 }
-                None => leftover = Some(all.clone()),
+                None => all_left = true,
             },
-            Method::MftCone => match self.quadrants(&tile, rays, toward, common_origin_cone, toward_cone) {
-                Some((b, sets, rest)) => {
+            Method::MftCone => match self.quadrants(tile, rays, toward, common_origin_cone, toward_cone) {
+                Some((b, sets, left)) => {
                     if let Some(c4) = Frustum4::new(b) {
-                        self.tree.occluded_mft(&c4, &tile, &sets, self.options.cull, &mut blocked, stats);
+                        self.tree.occluded_mft(&c4, tile, &sets, self.options.cull, blocked, stats);
                     }
-                    leftover = Some(rest);
+                    rest = Some(left);
                 }
-                None => leftover = Some(all.clone()),
+                None => all_left = true,
             },
-            _ => leftover = Some(all.clone()),
+            _ => all_left = true,
         }
-        let mut stack = PacketStack::default();
-        for j in leftover.unwrap_or_default() {
-            blocked[j] = self.tree.occluded_packet(&tile.packets[j], &mut stack, stats);
+        let left = if all_left { all } else { rest.as_deref().unwrap_or_default() };
+        for &j in left {
+            blocked[j] = self.tree.occluded_packet(&tile.packets[j], stack, stats);
         }
         for (j, b) in blocked.iter().enumerate() {
             let bits = b.bits();
@@ -539,7 +557,27 @@ impl Kernel for OccludedSimd<'_, '_> {
     type Output = ();
     #[inline(always)]
     fn run<V: Vf32>(self) {
-        self.tracer.occluded_simd::<V>(self.rays, self.width, self.height, self.toward, self.out, self.stats);
+        let Self { tracer, rays, width, height, toward, out, stats } = self;
+        tracer.occluded_simd::<V>(&mut TileScratch::default(), rays, width, height, toward, out, stats);
+    }
+}
+
+/// The buffers of a tile's occlusion walk ([`Tracer::occluded_simd`], [`Tracer::occluded_in_proxy_simd`]),
+/// kept by kernels that trace many small tiles so that each does not allocate them anew.
+pub(crate) struct TileScratch<V: Vf32> {
+    /// The tile's packets.
+    pub tile: PacketTile<V>,
+    /// Indices of the packets that take part in the walk.
+    pub all: Vec<usize>,
+    /// Per packet, its blocked lanes.
+    pub blocked: Vec<V::Mask>,
+    /// The stack of packets traced alone.
+    pub stack: PacketStack<V>,
+}
+
+impl<V: Vf32> Default for TileScratch<V> {
+    fn default() -> Self {
+        Self { tile: PacketTile::new(&[], 0, 0), all: Vec::new(), blocked: Vec::new(), stack: PacketStack::default() }
     }
 }
 

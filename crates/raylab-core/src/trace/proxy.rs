@@ -10,11 +10,11 @@ use glam::Vec3;
 use raylab_simd::{Kernel, VMask, Vf32};
 
 use crate::method::Method;
-use crate::packet::{Cone, Frustum, PacketTile};
+use crate::packet::{Cone, Frustum};
 use crate::ray::Ray;
 use crate::stats::TraversalStats;
 
-use super::Tracer;
+use super::{TileScratch, Tracer};
 
 /// A bound on a bundle of rays from one point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,16 +73,42 @@ impl Kernel for OccludedInProxy<'_, '_> {
     type Output = ();
     #[inline(always)]
     fn run<V: Vf32>(self) {
-        let Self { tracer, proxy, rays, size: (width, height), out, stats } = self;
-        let tile = PacketTile::<V>::new(rays, width, height);
-        let all: Vec<usize> = (0..tile.packets.len()).filter(|&j| tile.packets[j].valid.any()).collect();
-        stats.rays += all.iter().map(|&j| tile.packets[j].valid.bits().count_ones() as u64).sum::<u64>();
+        let Self { tracer, proxy, rays, size, out, stats } = self;
+        tracer.occluded_in_proxy_simd::<V>(&mut TileScratch::default(), proxy, rays, size, out, stats);
+    }
+}
+
+impl Tracer<'_> {
+    /// [`Tracer::occluded_in_proxy`]'s walk with lane type `V` (not for the reference method): for kernels
+    /// that trace many bundles in one dispatch.
+    #[inline(always)]
+    pub(crate) fn occluded_in_proxy_simd<V: Vf32>(
+        &self,
+        scratch: &mut TileScratch<V>,
+        proxy: &Proxy,
+        rays: &[Option<Ray>],
+        (width, height): (usize, usize),
+        out: &mut [bool],
+        stats: &mut TraversalStats,
+    ) {
+        let TileScratch { tile, all, blocked, .. } = scratch;
+        tile.refill(rays, width, height);
+        // Plain loops: vector code must be inlined into the SIMD entry point (see `map3`).
+        all.clear();
+        for (j, p) in tile.packets.iter().enumerate() {
+            let bits = p.valid.bits();
+            if bits != 0 {
+                all.push(j);
+                stats.rays += bits.count_ones() as u64;
+            }
+        }
         stats.packets += all.len() as u64;
-        let mut blocked = vec![V::Mask::from_bits(0); tile.packets.len()];
-        let (tree, cull) = (tracer.tree, tracer.options.cull);
+        blocked.clear();
+        blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
+        let (tree, cull) = (self.tree, self.options.cull);
         match proxy {
-            Proxy::Pyramid(f) => tree.occluded_frustum(f, &tile, &all, cull, &mut blocked, stats),
-            Proxy::Cone(c) => tree.occluded_frustum(c, &tile, &all, cull, &mut blocked, stats),
+            Proxy::Pyramid(f) => tree.occluded_frustum(f, tile, all, cull, blocked, stats),
+            Proxy::Cone(c) => tree.occluded_frustum(c, tile, all, cull, blocked, stats),
         }
         for (j, b) in blocked.iter().enumerate() {
             let bits = b.bits();
