@@ -50,47 +50,28 @@ impl<V: Vf32> PacketTile<V> {
     /// Cuts `rays` (row-major, `width x height`) into packets.
     #[inline(always)]
     pub fn new(rays: &[Option<Ray>], width: usize, height: usize) -> Self {
-        let mut tile = Self {
-            packets: Vec::new(),
-            hits: Vec::new(),
-            farthest_hit: Vec::new(),
-            batch: None,
-            origin_pixel: Vec::new(),
-            cols: 0,
-            rows: 0,
-            width: 0,
-            height: 0,
-        };
-        tile.refill(rays, width, height);
-        tile
-    }
-
-    /// [`PacketTile::new`] in place, keeping the buffers: for kernels that trace many small tiles, one after
-    /// the other (a point's light samples), where allocating them for each would cost as much as the packing.
-    #[inline(always)]
-    pub fn refill(&mut self, rays: &[Option<Ray>], width: usize, height: usize) {
         let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
         let (cols, rows) = (width.div_ceil(pw), height.div_ceil(ph));
-        (self.cols, self.rows, self.width, self.height, self.batch) = (cols, rows, width, height, None);
-        self.packets.clear();
-        self.origin_pixel.clear();
+        let mut packets = Vec::with_capacity(cols * rows);
+        let mut origin_pixel = Vec::with_capacity(cols * rows);
         for by in 0..rows {
             for bx in 0..cols {
-                self.packets.push(RayPacket::gather(|i| {
+                packets.push(RayPacket::gather(|i| {
                     let (x, y) = (pw * bx + i % pw, ph * by + i / pw);
                     if x < width && y < height { rays[y * width + x] } else { None }
                 }));
-                self.origin_pixel.push((pw * bx, ph * by));
+                origin_pixel.push((pw * bx, ph * by));
             }
         }
         // Plain loops: vector code must be inlined into the SIMD entry point (see `map3`).
-        self.hits.clear();
-        self.farthest_hit.clear();
-        for p in &self.packets {
-            self.hits.push(PacketHits::new(p));
-            self.farthest_hit.push(V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max());
+        let mut hits = Vec::with_capacity(packets.len());
+        let mut farthest_hit = Vec::with_capacity(packets.len());
+        for p in &packets {
+            hits.push(PacketHits::new(p));
+            farthest_hit.push(V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max());
         }
-        self.farthest_hit.resize(self.packets.len().div_ceil(V::LANES) * V::LANES, f32::NEG_INFINITY);
+        farthest_hit.resize(packets.len().div_ceil(V::LANES) * V::LANES, f32::NEG_INFINITY);
+        Self { packets, hits, farthest_hit, batch: None, origin_pixel, cols, rows, width, height }
     }
 
     /// Prepares batched packet/leaf culling ([`BatchCull`]) for rays that all start at `origin` (the caller

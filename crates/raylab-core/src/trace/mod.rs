@@ -394,9 +394,8 @@ impl<'a> Tracer<'a> {
         out: &mut [bool],
         stats: &mut TraversalStats,
     ) {
-        let TileScratch { tile, all, blocked, stack } = scratch;
-        tile.refill(rays, width, height);
-        let tile = &mut *tile;
+        let TileScratch { all, blocked, stack } = scratch;
+        let mut tile = PacketTile::<V>::new(rays, width, height);
         blocked.clear();
         blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
         all.clear();
@@ -404,11 +403,11 @@ impl<'a> Tracer<'a> {
         let all = &all[..];
         if self.options.cull
             && self.options.method.is_bundled()
-            && let Some(origin) = common_origin(tile, all)
+            && let Some(origin) = common_origin(&tile, all)
         {
             tile.share_origin(origin);
         }
-        let tile = &*tile;
+        let tile = &tile;
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         let limit = self.options.shadow_spread_limit;
@@ -563,10 +562,9 @@ impl Kernel for OccludedSimd<'_, '_> {
 }
 
 /// The buffers of a tile's occlusion walk ([`Tracer::occluded_simd`], [`Tracer::occluded_in_proxy_simd`]),
-/// kept by kernels that trace many small tiles so that each does not allocate them anew.
+/// kept by kernels that trace many small tiles so that each does not allocate them anew. (The packets are
+/// cut anew for each tile: refilling a kept [`PacketTile`] made the packet walks over it slower.)
 pub(crate) struct TileScratch<V: Vf32> {
-    /// The tile's packets.
-    pub tile: PacketTile<V>,
     /// Indices of the packets that take part in the walk.
     pub all: Vec<usize>,
     /// Per packet, its blocked lanes.
@@ -577,7 +575,7 @@ pub(crate) struct TileScratch<V: Vf32> {
 
 impl<V: Vf32> Default for TileScratch<V> {
     fn default() -> Self {
-        Self { tile: PacketTile::new(&[], 0, 0), all: Vec::new(), blocked: Vec::new(), stack: PacketStack::default() }
+        Self { all: Vec::new(), blocked: Vec::new(), stack: PacketStack::default() }
     }
 }
 
