@@ -96,7 +96,7 @@ pub fn shade_reflection_set(
     let ctx = TileContext {
         scene,
         tracer,
-        raster: camera.raster(w, h),
+        primary: camera.raster(w, h).grid(),
         light,
         settings: &one_bounce,
         width: w,

@@ -24,7 +24,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::ray::{Hit, Ray};
-use crate::scene::{Camera, CameraRaster, PointLight, Scene};
+use crate::scene::{Camera, PointLight, PrimaryGrid, Scene};
 use crate::shadow::Shadows;
 use crate::stats::TraversalStats;
 use crate::trace::{TraceOptions, Tracer};
@@ -112,7 +112,7 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
     let ctx = TileContext {
         scene,
         tracer,
-        raster: camera.raster(w, h),
+        primary: camera.raster(w, h).grid(),
         light,
         settings,
         width: w,
@@ -210,7 +210,8 @@ fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
 struct TileContext<'a> {
     scene: &'a Scene,
     tracer: &'a Tracer<'a>,
-    raster: CameraRaster,
+    /// The frame's primary rays.
+    primary: PrimaryGrid,
     light: PointLight,
     settings: &'a RenderSettings,
     width: u32,
@@ -289,7 +290,7 @@ impl TileContext<'_> {
         sc.pixels.clear();
         sc.pixels.extend(offsets.map(|(dx, dy)| (x0 + dx, y0 + dy)));
         sc.rays.clear();
-        sc.rays.extend(sc.pixels.iter().map(|&(x, y)| Some(self.raster.primary(x, y))));
+        sc.rays.extend(sc.pixels.iter().map(|&(x, y)| Some(self.primary.primary(x, y))));
         let n = sc.rays.len();
         let (rw, rh) = if rows { (bw as usize, bh as usize) } else { (n, 1) };
         sc.hits.clear();

@@ -39,6 +39,7 @@ pub struct Surface<'a> {
 
 impl<'a> Surface<'a> {
     /// The surface at `hit` along `ray`.
+    #[inline(always)]
     pub fn at(scene: &'a Scene, ray: &Ray, hit: &Hit) -> Self {
         let tri = &scene.triangles[hit.tri as usize];
         let material = &scene.materials[tri.material as usize];
@@ -67,6 +68,7 @@ impl<'a> Surface<'a> {
 
     /// The local colour lit by `light`, of which a fraction `visibility` reaches the point; `view` is the
     /// incoming ray's direction.
+    #[inline]
     pub fn local(&self, view: Vec3, light: &PointLight, visibility: f32) -> Vec3 {
         let to_light = light.position - self.point;
         let dist = to_light.length();

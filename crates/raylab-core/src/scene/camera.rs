@@ -161,10 +161,54 @@ impl CameraRaster {
 
     /// The primary ray through the continuous raster position `(px, py)` (pixel centres at `+0.5`).
     pub fn primary_at(&self, px: f64, py: f64) -> Ray {
+        through(self.eye, self.column(px) - self.row(py))
+    }
+
+    /// The primary rays of the whole raster with their per-column and per-row terms computed once, for
+    /// renderers that make a ray for every pixel.
+    pub fn grid(&self) -> PrimaryGrid {
+        let (w, h) = (self.width as u32, self.height as u32);
+        PrimaryGrid {
+            eye: self.eye,
+            columns: (0..w).map(|x| self.column(x as f64 + 0.5)).collect(),
+            rows: (0..h).map(|y| self.row(y as f64 + 0.5)).collect(),
+        }
+    }
+
+    /// The direction's part that depends on the raster column, `f + sx r`: the harness sums it first.
+    fn column(&self, px: f64) -> DVec3 {
         let sx = 2.0 * px / self.width - 1.0;
+        self.f + sx * self.r
+    }
+
+    /// The direction's part that depends on the raster row, `sy u`, subtracted from the column's.
+    fn row(&self, py: f64) -> DVec3 {
         let sy = 2.0 * py / self.height - 1.0;
-        let d = (self.f + sx * self.r - sy * self.u).normalize();
-        Ray::new(self.eye, d.as_vec3())
+        sy * self.u
+    }
+}
+
+/// The ray from `eye` along the unnormalised double-precision direction `d`, rounded to `f32` at the end.
+#[inline]
+fn through(eye: Vec3, d: DVec3) -> Ray {
+    Ray::new(eye, d.normalize().as_vec3())
+}
+
+/// Every pixel centre's primary ray of one [`CameraRaster`], bit for bit [`CameraRaster::primary`], with
+/// the divisions and products that depend on only the column or only the row done once per frame rather
+/// than once per pixel.
+#[derive(Clone, Debug)]
+pub struct PrimaryGrid {
+    eye: Vec3,
+    columns: Vec<DVec3>,
+    rows: Vec<DVec3>,
+}
+
+impl PrimaryGrid {
+    /// The primary ray through the centre of pixel `(x, y)`, which must lie in the raster.
+    #[inline]
+    pub fn primary(&self, x: u32, y: u32) -> Ray {
+        through(self.eye, self.columns[x as usize] - self.rows[y as usize])
     }
 }
 
@@ -193,6 +237,32 @@ mod tests {
             let (fx, fy) = ((nx + 1.0) * 0.5 * w as f32, (1.0 - ny) * 0.5 * h as f32);
             assert!((fx - (x as f32 + 0.5)).abs() < 1e-3 && (fy - (y as f32 + 0.5)).abs() < 1e-3, "{fx} {fy}");
             assert!((0.0..1.0).contains(&nz), "depth {nz}");
+        }
+    }
+
+    #[test]
+    fn the_grid_gives_every_pixel_exactly_its_primary_ray() {
+        let cam = Camera {
+            eye: Vec3::new(-12.5, 2.5, 0.1),
+            target: Vec3::new(10.0, 5.5, -3.0),
+            up: Vec3::new(0.1, 1.0, 0.0),
+            vfov_deg: 65.0,
+            aperture: 0.0,
+            focus_distance: 1.0,
+        };
+        for (w, h) in [(1, 1), (7, 3), (64, 48), (1, 1000)] {
+            let raster = cam.raster(w, h);
+            let grid = raster.grid();
+            for y in 0..h {
+                for x in 0..w {
+                    let (a, b) = (grid.primary(x, y), raster.primary(x, y));
+                    assert_eq!(
+                        (a.origin, a.dir, a.tmin, a.tmax),
+                        (b.origin, b.dir, b.tmin, b.tmax),
+                        "{w}x{h} ({x}, {y})"
+                    );
+                }
+            }
         }
     }
 

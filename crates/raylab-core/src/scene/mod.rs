@@ -8,7 +8,7 @@ mod light;
 mod material;
 mod texture;
 
-pub use camera::{Camera, CameraError, CameraRaster, View};
+pub use camera::{Camera, CameraError, CameraRaster, PrimaryGrid, View};
 pub use light::PointLight;
 pub use material::{Material, MaterialKind, TextureId};
 pub use texture::{Texture, WrapMode};
