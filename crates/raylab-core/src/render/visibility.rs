@@ -10,7 +10,7 @@
 use raylab_simd::{Kernel, Vf32};
 
 use crate::method::Method;
-use crate::packet::MAX_LANES;
+use crate::packet::{MAX_LANES, packet_shape};
 use crate::ray::{Hit, Ray};
 use crate::scene::{PointLight, Scene};
 use crate::shadow::{EdgeWidth, LightSamples, SampleBound, ShadowCache, Shadows};
@@ -27,6 +27,8 @@ pub struct ShadowScratch {
     edge: Vec<EdgeWidth>,
     samples: LightSamples,
     rays: Vec<Option<Ray>>,
+    /// Where each point's rays start in `rays`, and how many there are (`None`: no point, or it faces away).
+    starts: Vec<Option<(usize, usize)>>,
     blocked: Vec<bool>,
     walks: Vec<Ray>,
     widths: Vec<f32>,
@@ -152,7 +154,7 @@ impl ShadowTracer<'_> {
 }
 
 /// Multi-sampled visibility of a layer's points: each point's samples on the light, traced as one bundle
-/// under the technique's bound. A [`Kernel`], so that drawing the samples, building the rays and tracing
+/// under the technique's bound (plain packets may hold the bundles of several neighbouring points). A [`Kernel`], so that drawing the samples, building the rays and tracing
 /// them all run inside one SIMD entry point per layer (drawn outside it, in baseline x86-64 code, the
 /// samples took about a seventh of a 16-sample frame), with the tile buffers reused from point to point.
 struct MultiSampled<'t, 'a> {
@@ -169,6 +171,9 @@ struct MultiSampled<'t, 'a> {
 /// How [`MultiSampled`] traces one point's bundle (a trait rather than a closure, so that the SIMD
 /// kernel's walk is always inlined into its entry point).
 trait BundleTracer {
+    /// Rays per packet of the walk (1 for ray-by-ray tracers).
+    fn lanes(&self) -> usize;
+
     /// Marks in `blocked` which of `rays` (a `size` grid) something blocks, inside `proxy` where there is one.
     fn trace(
         &mut self,
@@ -186,6 +191,10 @@ struct ReferenceBundles<'t, 'a> {
 }
 
 impl BundleTracer for ReferenceBundles<'_, '_> {
+    fn lanes(&self) -> usize {
+        1
+    }
+
     fn trace(
         &mut self,
         proxy: Option<&Proxy>,
@@ -210,6 +219,11 @@ struct SimdBundles<'a, V: Vf32> {
 
 impl<V: Vf32> BundleTracer for SimdBundles<'_, V> {
     #[inline(always)]
+    fn lanes(&self) -> usize {
+        V::LANES
+    }
+
+    #[inline(always)]
     fn trace(
         &mut self,
         proxy: Option<&Proxy>,
@@ -226,27 +240,51 @@ impl<V: Vf32> BundleTracer for SimdBundles<'_, V> {
 }
 
 impl MultiSampled<'_, '_> {
-    /// Fills `out` with each point's lit fraction, tracing its bundle with `tracer`.
+    /// Fills `out` with each point's lit fraction, tracing its bundle with `tracer`. Plain packets do not
+    /// need a point's samples to themselves: where they fill only part of a packet (4 samples in 8 or 16
+    /// lanes, 8 in 16), the samples of that many neighbouring points share it.
     #[inline(always)]
     fn trace_with(self, tracer: &mut impl BundleTracer) {
         let Self { st, surfaces, seeds, samples, bound, stats, sc, out } = self;
         let (light, eps) = (&st.light, st.epsilon);
         let center = light.position;
-        for (s, &seed) in surfaces.iter().zip(seeds) {
-            let Some((s, apex)) = s.as_ref().and_then(|s| Some((s, shadow_ray(s, center, center, eps)?.origin))) else {
-                out.push(0.0);
-                continue;
-            };
-            sc.samples.generate(center, light.radius, s.point, samples, seed);
+        let (lanes, n) = (tracer.lanes(), samples as usize);
+        let shared = bound == SampleBound::Packets && n < lanes && lanes % n == 0;
+        let group = if shared { lanes / n } else { 1 };
+        for (points, seeds) in surfaces.chunks(group).zip(seeds.chunks(group)) {
             sc.rays.clear();
-            sc.rays.extend(sc.samples.points.iter().map(|&p| shadow_ray(s, center, p, eps)));
+            sc.starts.clear();
+            let mut proxy = None;
+            let mut size = (0, 0);
+            for (s, &seed) in points.iter().zip(seeds) {
+                let Some((s, apex)) = s.as_ref().and_then(|s| Some((s, shadow_ray(s, center, center, eps)?.origin)))
+                else {
+                    sc.starts.push(None);
+                    continue;
+                };
+                sc.samples.generate(center, light.radius, s.point, samples, seed);
+                sc.starts.push(Some((sc.rays.len(), sc.samples.points.len())));
+                sc.rays.extend(sc.samples.points.iter().map(|&p| shadow_ray(s, center, p, eps)));
+                size = (sc.samples.width as usize, sc.samples.height as usize);
+                proxy = bound.proxy(apex, &sc.samples.disc);
+            }
+            if shared {
+                // One packet's rows, in order: the points' samples follow one another along them.
+                let (w, h) = packet_shape(lanes);
+                sc.rays.resize(sc.rays.len().next_multiple_of(w * h), None);
+                size = (w, sc.rays.len() / w);
+            }
             sc.blocked.clear();
             sc.blocked.resize(sc.rays.len(), false);
-            let size = (sc.samples.width as usize, sc.samples.height as usize);
-            let proxy = bound.proxy(apex, &sc.samples.disc);
-            tracer.trace(proxy.as_ref(), &sc.rays, size, &mut sc.blocked, stats);
-            let lit = sc.rays.iter().zip(&sc.blocked).filter(|(r, b)| r.is_some() && !**b).count();
-            out.push(lit as f32 / sc.rays.len() as f32);
+            if !sc.rays.is_empty() {
+                tracer.trace(proxy.as_ref(), &sc.rays, size, &mut sc.blocked, stats);
+            }
+            for start in &sc.starts {
+                out.push(start.map_or(0.0, |(k, len)| {
+                    let lit = sc.rays[k..k + len].iter().zip(&sc.blocked[k..]).filter(|(r, b)| r.is_some() && !**b);
+                    lit.count() as f32 / len as f32
+                }));
+            }
         }
     }
 }
