@@ -4,8 +4,9 @@
 //! frustum methods trace them as frustums from the light, as the thesis does); the shadow cache is a
 //! single-ray technique (DACRT, which traces sets, consults the cache for a whole layer at once); edge widths
 //! start as hard shadows, and the blocked segments then walk the kd-tree for their widths, in packets except
-//! under the single-ray methods; multi-sampling traces each point's samples as one bundle: plain packets, a pyramid fitted to them, or a
-//! pyramid or cone around the light built before the samples ([`crate::trace::Proxy`]).
+//! under the single-ray methods; multi-sampling traces each point's samples as one bundle: plain packets
+//! (shared by neighbouring points when their samples are fewer than a packet's lanes), a pyramid fitted to
+//! them, or a pyramid or cone around the light built before the samples ([`crate::trace::Proxy`]).
 
 use raylab_simd::{Kernel, Vf32};
 
@@ -154,9 +155,10 @@ impl ShadowTracer<'_> {
 }
 
 /// Multi-sampled visibility of a layer's points: each point's samples on the light, traced as one bundle
-/// under the technique's bound (plain packets may hold the bundles of several neighbouring points). A [`Kernel`], so that drawing the samples, building the rays and tracing
-/// them all run inside one SIMD entry point per layer (drawn outside it, in baseline x86-64 code, the
-/// samples took about a seventh of a 16-sample frame), with the tile buffers reused from point to point.
+/// under the technique's bound (plain packets may hold the bundles of several neighbouring points). A
+/// [`Kernel`], so that drawing the samples, building the rays and tracing them all run inside one SIMD
+/// entry point per layer (drawn outside it, in baseline x86-64 code, the samples took about a seventh of a
+/// 16-sample frame), with the tile buffers reused from point to point.
 struct MultiSampled<'t, 'a> {
     st: &'t ShadowTracer<'a>,
     surfaces: &'t [Option<Surface<'a>>],

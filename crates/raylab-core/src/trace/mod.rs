@@ -410,36 +410,18 @@ impl<'a> Tracer<'a> {
         let tile = &tile;
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
-        let limit = self.options.shadow_spread_limit;
         // Packets no bundle covers are traced as packets afterwards: all of them, or the quadrants' rest.
         let mut rest: Option<Vec<usize>> = None;
         let mut all_left = false;
         match self.options.method {
-            Method::Frustum => {
-                let whole = Bundled { tile, set: all, rays: RayRect { rays, width, x: 0..width, y: 0..height } };
-                // `match`es, not `Option::or_else`: the compiler may keep a closure's vector code out of line.
-                let bundle = match (common_origin_frustum(tile, all), toward) {
-                    (Some(f), _) => Some(f),
-                    (None, Some(t)) => toward_frustum(&whole, t, limit),
-                    (None, None) => None,
-                };
-                match bundle {
-                    Some(f) => self.tree.occluded_frustum(&f, tile, all, self.options.cull, blocked, stats),
-                    None => all_left = true,
-                }
-            }
-            Method::Cone => {
-                let whole = Bundled { tile, set: all, rays: RayRect { rays, width, x: 0..width, y: 0..height } };
-                let bundle = match (common_origin_cone(tile, all), toward) {
-                    (Some(c), _) => Some(c),
-                    (None, Some(t)) => toward_cone(&whole, t, limit),
-                    (None, None) => None,
-                };
-                match bundle {
-                    Some(c) => self.tree.occluded_frustum(&c, tile, all, self.options.cull, blocked, stats),
-                    None => all_left = true,
-                }
-            }
+            Method::Frustum => match self.whole(tile, all, rays, toward, common_origin_frustum, toward_frustum) {
+                Some(f) => self.tree.occluded_frustum(&f, tile, all, self.options.cull, blocked, stats),
+                None => all_left = true,
+            },
+            Method::Cone => match self.whole(tile, all, rays, toward, common_origin_cone, toward_cone) {
+                Some(c) => self.tree.occluded_frustum(&c, tile, all, self.options.cull, blocked, stats),
+                None => all_left = true,
+            },
             Method::Mft => match self.quadrants(tile, rays, toward, common_origin_frustum, toward_frustum) {
                 Some((b, sets, left)) => {
                     if let Some(f4) = Frustum4::new(b) {
@@ -468,6 +450,27 @@ impl<'a> Tracer<'a> {
             let bits = b.bits();
             tile.for_each_lane(j, |pixel, lane| out[pixel] = bits >> lane & 1 == 1);
         }
+    }
+
+    /// The one bundle of a whole tile, packets `all`: `common` builds it from packets with one origin,
+    /// `toward_fn` from segments that end at a light (function items rather than `Option::or_else`
+    /// closures, whose vector code the compiler may keep out of line).
+    #[inline(always)]
+    fn whole<V: Vf32, B>(
+        &self,
+        tile: &PacketTile<V>,
+        all: &[usize],
+        rays: &[Option<Ray>],
+        toward: Option<Vec3>,
+        common: fn(&PacketTile<V>, &[usize]) -> Option<B>,
+        toward_fn: fn(&Bundled<V>, Vec3, f32) -> Option<B>,
+    ) -> Option<B> {
+        if let Some(b) = common(tile, all) {
+            return Some(b);
+        }
+        let (w, h) = (tile.width, tile.height);
+        let whole = Bundled { tile, set: all, rays: RayRect { rays, width: w, x: 0..w, y: 0..h } };
+        toward_fn(&whole, toward?, self.options.shadow_spread_limit)
     }
 
     /// The four quadrant bundles of a tile (in whole packets) and the packets each bounds; `common` builds a
