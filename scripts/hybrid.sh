@@ -7,21 +7,27 @@
 #
 #   scripts/hybrid.sh                 # 40 frames per row
 #   FRAMES=20 scripts/hybrid.sh
+#
+# On a machine without Rust (a lent GPU machine) with a prebuilt target/release/raylab:
+#   SKIP_BUILD=1 COMMIT=abc123 SECTION=hybrid-gpu scripts/hybrid.sh
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 # shellcheck source=lib/splice.sh
 source "$root/scripts/lib/splice.sh"
 frames=${FRAMES:-40}
-cargo build --release -p raylab-viewer --manifest-path "$root/Cargo.toml"
+section=${SECTION:-hybrid}
+[ -n "${SKIP_BUILD:-}" ] || cargo build --release -p raylab-viewer --manifest-path "$root/Cargo.toml"
 cd "$root"
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(mktemp -d)}
 work=$(mktemp -d)
 table="$work/table.md"
-commit=$(git describe --always --dirty --abbrev=12)
+commit=${COMMIT:-$(git describe --always --dirty --abbrev=12)}
+toolchain=$(rustc --version 2>/dev/null || echo "binary built elsewhere")
+gpus="$work/gpus"
 cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
 sponza=(--scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0)
 {
-  echo "Machine and build: commit $commit, $(rustc --version), CPU $cpu ($(nproc) logical CPUs), the GPU named in each run's stats (lavapipe here: Mesa's software Vulkan, on the same CPU)."
+  echo "Machine and build: commit $commit, $toolchain, CPU $cpu ($(nproc) logical CPUs), GPU GPU_NAMES."
   echo "Command: \`scripts/hybrid.sh\` (FRAMES=$frames): for each row, \`target/release/raylab --headless --mode hybrid --width 1280 --height 720 --no-panel --frames $frames --json-stats FILE\` with the row's flags; medians over the frames. CPU part = raster (record and submit) + readback + trace."
   echo
   echo "| part | scene | triangles | G-buffer | readback | interlace | reflection method | reflective px | rays | raster ms | readback ms | trace ms | upload ms | composite ms | CPU part ms | frame period ms |"
@@ -32,10 +38,11 @@ row() {
   local stats="$work/run.json"
   target/release/raylab --headless --mode hybrid --width 1280 --height 720 --no-panel --frames "$frames" \
     --json-stats "$stats" "$@" > /dev/null
-  python3 - "$stats" "$part" >> "$table" <<'PY'
+  python3 - "$stats" "$part" "$gpus" >> "$table" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
 h, s = d["hybrid"], d["settings"]["hybrid"]
+print(d["gpu"], file=open(sys.argv[3], "a"))
 m = h["medians"]["stage_ms_median"]
 med = h["medians"]
 print(f"| {sys.argv[2]} | {d['scene']} | {d['triangles']} | {s['gbuffer_percent']}% ({h['gbuffer'][0]}x{h['gbuffer'][1]}) "
@@ -52,6 +59,8 @@ row "(c) readback" --scene atrium
 for k in 2 4; do row "(c) interlacing" --scene atrium --interlace "$k"; done
 for m in mono mbvh; do row "(c) method" --scene atrium --hybrid-method "$m"; done
 
-splice_section hybrid "$table"
+# The adapter each run reported (lavapipe is Mesa's software Vulkan, on the same CPU as the tracer).
+sed -i "s|GPU_NAMES|$(sort -u "$gpus" | paste -sd ';' | sed 's/[|&]/\\&/g')|" "$table"
+splice_section "$section" "$table"
 rm -rf "$work"
 echo "updated docs/BENCHMARKS.md"
