@@ -13,6 +13,8 @@ use crate::lab::Lab;
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// How long a headless run may wait for its frames before giving up.
 const PATIENCE: Duration = Duration::from_secs(600);
+/// The longest sleep between two UI frames when nothing wakes the loop.
+const IDLE_FRAME: Duration = Duration::from_millis(100);
 
 /// Runs `automation` offscreen at `size` pixels.
 pub fn run(
@@ -67,7 +69,9 @@ pub fn run(
                 PATIENCE.as_secs()
             ));
         }
-        // Sleep until the worker has news, redrawing the UI at least every 100 ms.
-        let _ = rx.recv_timeout(Duration::from_millis(100));
+        // Sleep until the worker has news or the lab wants a redraw (a G-buffer on its way back from the GPU
+        // is polled every few milliseconds, as in the window), and at most IDLE_FRAME.
+        let sleep = lab.next_redraw().map_or(IDLE_FRAME, |d| d.min(IDLE_FRAME));
+        let _ = rx.recv_timeout(sleep);
     }
 }
