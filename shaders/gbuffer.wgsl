@@ -2,9 +2,11 @@
 // camera's exact projection (`CameraRaster::clip_matrix`), so each pixel centre sees what the CPU's primary
 // ray through it would see, and writes per pixel:
 //   target 0 (rgba32float): world position, and material id + 1 in w (0 where nothing was drawn);
-//   target 1 (rgba32float): unit shading normal turned toward the viewer, and the material's reflection
-//                           weight in w (0 for surfaces that do not reflect: the reflectivity flag);
+//   target 1 (rgba32float): unit shading normal turned toward the viewer, and in w the distance from the eye
+//                           where the material reflects (reflection weight above 0), else 0;
 //   depth (depth32float).
+// The CPU reads target 1 alone back (16 bytes a pixel): it needs only the reflective pixels, and puts each on
+// its primary ray at that distance.
 // Normals are turned exactly as the CPU shades a hit: the geometric normal toward the viewer, the shading
 // normal onto the geometric normal's side.
 
@@ -61,6 +63,6 @@ fn fs_main(v: VertexOut) -> GBuffer {
     }
     var out: GBuffer;
     out.position = vec4<f32>(v.world, v.material.x + 1.0);
-    out.normal = vec4<f32>(n, v.material.y);
+    out.normal = vec4<f32>(n, select(0.0, length(view), v.material.y > 0.0));
     return out;
 }

@@ -7,7 +7,6 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-use rayon::prelude::*;
 
 use raylab_core::distribution::{Accumulator, render_pass};
 use raylab_core::method::Method;
@@ -406,9 +405,6 @@ fn send(tx: &Sender<WorkerEvent>, wake: &dyn Fn(), ev: WorkerEvent) {
     wake();
 }
 
-/// Rows of the G-buffer one task of the reflective-pixel scan takes.
-const SCAN_BAND_ROWS: usize = 16;
-
 /// The R-buffer (and its display bytes) kept from frame to frame for interlacing, and which rows come next.
 #[derive(Default)]
 struct Interlaced {
@@ -419,17 +415,17 @@ struct Interlaced {
 }
 
 /// Traces and shades the reflection rays of `r`'s G-buffer on the current rayon pool: every row, or every
-/// k-th row in turn when interlacing (the other rows keep the previous frame's reflections). One pass over
-/// the G-buffer counts its reflective pixels and builds the rays of those in the traced rows; only those
-/// pixels are traced and written, so the cost follows the mirrors on screen rather than the G-buffer's size.
+/// k-th row in turn when interlacing (the other rows keep the previous frame's reflections). The readback
+/// kept only the reflective pixels; those in the traced rows get rays, and only they are traced and written,
+/// so the cost follows the mirrors on screen rather than the G-buffer's size.
 fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rendered {
     let t0 = Instant::now();
     let job = &r.job;
     let g = &r.gbuffer;
     let (w, h) = (g.width, g.height);
     let k = job.settings.hybrid.interlace.max(1);
-    if kept.size != (w, h) || kept.colors.len() != g.pixels.len() {
-        let n = g.pixels.len();
+    let n = w as usize * h as usize;
+    if kept.size != (w, h) || kept.colors.len() != n {
         *kept =
             Interlaced { size: (w, h), colors: vec![[0.0, 0.0, 0.0, 1.0]; n], rgba: vec![[0, 0, 0, 255]; n], phase: 0 };
     }
@@ -437,33 +433,15 @@ fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rend
     kept.phase = kept.phase.wrapping_add(1);
     let eps = surface_epsilon(s.scene);
     let row_len = (w as usize).max(1);
-    // Bands of rows scanned in parallel (the scan reads the whole G-buffer, megabytes at 720p), then joined in
-    // image order.
-    let bands: Vec<(usize, Vec<(u32, Ray)>)> = g
-        .pixels
-        .par_chunks(row_len * SCAN_BAND_ROWS)
-        .enumerate()
-        .map(|(band, pixels)| {
-            let mut reflective = 0;
-            let mut set = Vec::new();
-            for (dy, row) in pixels.chunks(row_len).enumerate() {
-                let y = band * SCAN_BAND_ROWS + dy;
-                let traced = y as u32 % k == phase;
-                for (x, p) in row.iter().enumerate() {
-                    if p.material.is_none() || p.reflect <= 0.0 {
-                        continue;
-                    }
-                    reflective += 1;
-                    if traced && let Some(ray) = reflection_ray(job.camera.eye, p, eps) {
-                        set.push(((y * row_len + x) as u32, ray));
-                    }
-                }
-            }
-            (reflective, set)
-        })
+    let raster = job.camera.raster(w, h);
+    // The readback kept only the reflective pixels; those of the traced rows get rays.
+    let reflective = g.reflective.len();
+    let set: Vec<(u32, Ray)> = g
+        .reflective
+        .iter()
+        .filter(|t| (t.index as usize / row_len) as u32 % k == phase)
+        .filter_map(|t| reflection_ray(job.camera.eye, &g.pixel(&raster, t), eps).map(|r| (t.index, r)))
         .collect();
-    let reflective = bands.iter().map(|b| b.0).sum();
-    let set: Vec<(u32, Ray)> = bands.into_iter().flat_map(|b| b.1).collect();
     let settings = job.settings.render_settings(w, h);
     let options = raylab_core::trace::TraceOptions { method: job.settings.hybrid.method, ..job.settings.trace };
     let tracer = Tracer::new(s.tree, None, options).with_mbvh(s.mbvh).with_dacrt(s.dacrt);

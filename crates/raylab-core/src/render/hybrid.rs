@@ -18,23 +18,22 @@ use super::visibility::ShadowScratch;
 use super::whitted::Layer;
 use super::{RenderSettings, StageTimes, TileContext, TileOut, surface_epsilon};
 
-/// One G-buffer pixel as the CPU reads it back.
+/// One G-buffer pixel as the CPU needs it: only reflective pixels cast a ray, from their position along the
+/// mirror of the view direction about their normal.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GPixel {
     /// World position of the surface seen.
     pub position: Vec3,
-    /// The material seen, or `None` for the background.
-    pub material: Option<u32>,
     /// Unit shading normal, turned toward the viewer.
     pub normal: Vec3,
-    /// Weight of the reflection in the pixel's colour (0: not reflective).
-    pub reflect: f32,
+    /// Whether the surface reflects (its material's reflection weight is above 0); false for the background.
+    pub reflective: bool,
 }
 
 /// The reflection ray of a G-buffer pixel seen from `eye` (`None` for the background or a surface that does
 /// not reflect): it leaves `epsilon` above the surface along the normal, in the mirror direction.
 pub fn reflection_ray(eye: Vec3, px: &GPixel, epsilon: f32) -> Option<Ray> {
-    if px.material.is_none() || px.reflect <= 0.0 || !px.position.is_finite() {
+    if !px.reflective || !px.position.is_finite() {
         return None;
     }
     let d = (px.position - eye).normalize_or_zero();
@@ -155,9 +154,8 @@ pub fn cpu_gbuffer(scene: &Scene, tracer: &Tracer, camera: &Camera, width: u32, 
             let s = Surface::at(scene, &r, &h);
             GPixel {
                 position: s.point,
-                material: Some(scene.triangles[h.tri as usize].material),
                 normal: s.normal,
-                reflect: if s.material.kind.reflects() { s.material.reflect_blend.clamp(0.0, 1.0) } else { 0.0 },
+                reflective: s.material.kind.reflects() && s.material.reflect_blend > 0.0,
             }
         })
         .collect()

@@ -1,6 +1,7 @@
 //! The G-buffer pass (`shaders/gbuffer.wgsl`): the scene's triangles in one vertex buffer, rasterised from
 //! the CPU camera's projection into a position target and a normal target (both 32-bit float, with the
-//! material id and the reflection weight in their fourth channels) and a depth buffer.
+//! material id and, for reflective surfaces, the distance from the eye in their fourth channels) and a depth
+//! buffer.
 
 use raylab_core::scene::{Camera, Scene};
 
@@ -15,7 +16,7 @@ pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub struct Targets {
     /// Position (w: material id + 1, 0 for the background).
     pub position: wgpu::Texture,
-    /// Normal (w: reflection weight).
+    /// Normal (w: distance from the eye where the material reflects, else 0): all the CPU reads back.
     pub normal: wgpu::Texture,
     depth: wgpu::TextureView,
     /// Width and height in pixels.
