@@ -7,7 +7,6 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-
 use raylab_core::distribution::{Accumulator, render_pass};
 use raylab_core::method::Method;
 use raylab_core::render::{Frame, StageTimes, render};

@@ -117,7 +117,8 @@ impl CompositePass {
             self.rbuffer = Some((texture, size));
         }
         let Some((texture, _)) = &self.rbuffer else { return };
-        let bytes: Vec<u8> = colors.as_flattened().iter().flat_map(|f| f.to_le_bytes()).collect();
+        // The colours' own bytes (little-endian f32 on every host wgpu runs on), with no copy.
+        let bytes: &[u8] = bytemuck::cast_slice(colors);
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture,
@@ -125,7 +126,7 @@ impl CompositePass {
                 origin: wgpu::Origin3d::ZERO,
                 aspect: wgpu::TextureAspect::All,
             },
-            &bytes,
+            bytes,
             wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(16 * w), rows_per_image: Some(h) },
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
