@@ -232,7 +232,8 @@ pub struct MethodArgs {
     #[arg(long, value_parser = parse_backend)]
     pub backend: Option<raylab_simd::Backend>,
     /// Widest shadow bundle seen from the light (tangent of its half-angle) that frustum methods trace as a
-    /// frustum; wider ones go as 2x2 packets. 0 traces all shadow rays as packets.
+    /// frustum (hard shadows and edge-width walks); wider ones go as 2x2 packets. 0 traces all shadow rays as
+    /// packets.
     #[arg(long, default_value_t = raylab_core::trace::TraceOptions::SHADOW_SPREAD_LIMIT, value_parser = parse_non_negative)]
     pub shadow_spread_limit: f32,
     /// Walk MBVH RS child tasks in lane order instead of by accumulated hit length (to measure the ordering).

@@ -195,11 +195,82 @@ fn packet_edge_widths_equal_single_walks() {
             for backend in Backend::available() {
                 let tracer =
                     Tracer::new(&tree, None, TraceOptions { method: Method::Packet, backend, ..Default::default() });
-                let mut states = vec![single.clone(); MAX_LANES];
+                let mut states = vec![single.clone(); rays.len()];
                 let mut got = vec![-1.0; rays.len()];
-                tracer.edge_widths(&rays, &mut states, &mut got, &mut s);
+                tracer.edge_widths(&rays, None, &mut states, &mut got, &mut s);
                 for (i, (g, w)) in got.iter().zip(&want).enumerate() {
                     assert_eq!(g, w, "{name} {backend:?} ray {i} {:?} (leak fix {leak_fix})", rays[i]);
+                }
+            }
+        }
+    }
+}
+
+/// Edge-width walks of the bundled methods (the blocked segments of a tile, which end at the light, walked as
+/// one frustum or cone from there) give each ray the occlusion of its single walk, on every backend, with
+/// culling on and off: groups of one to a few hundred segments from around random spots, some right under
+/// the light (direction signs mixed inside one bundle, zero components) and some too wide for a bundle
+/// (which go as packets).
+#[test]
+fn bundle_edge_widths_equal_single_walks() {
+    for name in ["atrium", "arena", "kitchen", "forest"] {
+        let scene = builtin::build(name, Detail::Test).unwrap();
+        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let b = scene.bounds();
+        let mut rng = Jitter::new(5);
+        let mut point =
+            || Vec3::new(rng.range(b.min.x, b.max.x), rng.range(b.min.y, b.max.y), rng.range(b.min.z, b.max.z));
+        // Half the groups end at the scene's light, half at a random point (maybe inside geometry, so that
+        // crossings lie near both ends).
+        let mut groups: Vec<(Vec3, Vec<Ray>)> = Vec::new();
+        for g in 0..80 {
+            let light = if g % 2 == 0 { scene.lights[0].position } else { point() };
+            let mut centre = point();
+            if g % 4 == 0 {
+                (centre.x, centre.z) = (light.x, light.z);
+            }
+            // Most groups are narrow bundles; every sixth spreads over the whole scene.
+            let spread = if g % 6 == 5 { b.diagonal() } else { (centre - light).length() * 0.02 };
+            let n = [1, 37, 128, 300][(g / 4) % 4];
+            groups.push((
+                light,
+                (0..n)
+                    .map(|i| {
+                        let mut p = centre + spread * (point() - b.center()) / b.diagonal();
+                        if g % 4 == 0 && i % 3 == 0 {
+                            p.x = light.x;
+                        }
+                        let d = light - p;
+                        Ray::segment(p, d / d.length(), 0.0, d.length())
+                    })
+                    .collect(),
+            ));
+        }
+        for leak_fix in [false, true] {
+            let mut single = EdgeWidth::new(b.diagonal() * 0.05, leak_fix);
+            let mut s = TraversalStats::default();
+            let want: Vec<Vec<f32>> = groups
+                .iter()
+                .map(|(_, g)| g.iter().map(|r| tree.edge_width(r, &mut single, &mut s)).collect())
+                .collect();
+            let partial = want.iter().flatten().filter(|&&w| w > 0.0 && w < 1.0).count();
+            assert!(partial > 10, "{name}: only {partial} penumbra rays; the test says little");
+            for method in [Method::Frustum, Method::Mft, Method::Cone, Method::MftCone] {
+                for cull in [true, false] {
+                    for backend in Backend::available() {
+                        let options = TraceOptions { method, backend, cull, ..Default::default() };
+                        let tracer = Tracer::new(&tree, None, options);
+                        let mut s = TraversalStats::default();
+                        for ((light, g), want) in groups.iter().zip(&want) {
+                            let mut states = vec![single.clone(); g.len().max(MAX_LANES)];
+                            let mut got = vec![-1.0; g.len()];
+                            tracer.edge_widths(g, Some(*light), &mut states, &mut got, &mut s);
+                            for (i, (a, w)) in got.iter().zip(want).enumerate() {
+                                assert_eq!(a, w, "{name} {method:?} {backend:?} cull {cull} ray {i} {:?}", g[i]);
+                            }
+                        }
+                        assert!(s.packets_tested > 0, "{name} {method:?}: no group went as a bundle");
+                    }
                 }
             }
         }

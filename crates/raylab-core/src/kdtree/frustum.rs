@@ -172,7 +172,7 @@ pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
 
 /// What a frustum walk does at a leaf. A trait rather than a closure so that it is always inlined into the
 /// walk, and so compiled with the kernel's target features (see [`raylab_simd::Kernel`]).
-trait FrustumLeaf {
+pub(super) trait FrustumLeaf {
     /// Tests `leaf`; returns the distance beyond which no ray needs more leaves, and whether the walk can stop.
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool);
 }
@@ -265,7 +265,7 @@ impl KdTree {
 
     /// Walks the leaves the frustum overlaps, roughly front to back, handing each to `leaf`.
     #[inline(always)]
-    fn traverse_frustum<B: Bundle>(&self, f: &B, stats: &mut TraversalStats, leaf: &mut impl FrustumLeaf) {
+    pub(super) fn traverse_frustum<B: Bundle>(&self, f: &B, stats: &mut TraversalStats, leaf: &mut impl FrustumLeaf) {
         if self.triangles().is_empty() {
             return;
         }

@@ -122,13 +122,17 @@ impl ShadowTracer<'_> {
                 self.hard(surfaces, (width, height), stats, sc);
                 // Scratch outlives frames (see `render`), whose edge settings may differ.
                 if sc.edge.first().is_none_or(|e| e.settings() != (radius, leak_fix)) {
-                    sc.edge = vec![EdgeWidth::new(radius, leak_fix); MAX_LANES];
+                    sc.edge.clear();
                 }
                 sc.walks.clear();
                 sc.walks.extend(sc.rays.iter().zip(&sc.blocked).filter_map(|(r, &b)| r.filter(|_| b)));
+                let states = sc.walks.len().max(MAX_LANES);
+                if sc.edge.len() < states {
+                    sc.edge.resize(states, EdgeWidth::new(radius, leak_fix));
+                }
                 sc.widths.clear();
                 sc.widths.resize(sc.walks.len(), 0.0);
-                self.tracer.edge_widths(&sc.walks, &mut sc.edge, &mut sc.widths, stats);
+                self.tracer.edge_widths(&sc.walks, Some(center), &mut sc.edge, &mut sc.widths, stats);
                 let mut widths = sc.widths.iter();
                 sc.rays
                     .iter()
