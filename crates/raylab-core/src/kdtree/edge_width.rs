@@ -165,28 +165,9 @@ impl<V: Vf32> PacketLeaf<V> for EdgeWalks<'_, V> {
     #[inline(always)]
     fn visit(&mut self, ids: Range<usize>, active: V::Mask, t_far: V) -> (V, V::Mask) {
         let tris = self.tree.triangles();
-        let mut t = V::array_from_fn(|_| 0.0);
-        for &id in &self.tree.tri_ids()[ids] {
-            self.tests += 1;
-            let corners = tris.get(id);
-            let (hit, t_hit) = crossing_packet(self.p, corners, active);
-            if hit.none() {
-                continue;
-            }
-            t_hit.write_to(t.as_mut());
-            let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-            let mut bits = hit.bits();
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let state = &mut self.states[i];
-                if !state.seen(id) {
-                    let dir = Vec3::new(self.p.dir[0].lane(i), self.p.dir[1].lane(i), self.p.dir[2].lane(i));
-                    state.add(Crossing { t: t.as_ref()[i], tri: id, front: n.dot(dir) < 0.0 });
-                    self.pending |= 1 << i;
-                }
-            }
-        }
+        let ids = &self.tree.tri_ids()[ids];
+        self.tests += ids.len() as u64;
+        self.pending |= leaf_crossings(self.tree, self.p, ids, active, self.states, |i| i);
         let mut finished = 0u32;
         let mut bits = active.bits() & self.pending;
         if bits != 0 {
@@ -231,11 +212,9 @@ impl<V: Vf32> FrustumLeaf for BundleEdges<'_, V> {
         if ids.is_empty() {
             return (f32::INFINITY, false);
         }
-        let tris = self.tree.triangles();
         let bounds = self.tree.leaf_bounds(leaf.node);
         let grown = Aabb::new(bounds.min - Vec3::splat(self.pad), bounds.max + Vec3::splat(self.pad));
         let (pw, width) = (PacketTile::<V>::PACKET_W, self.tile.width);
-        let mut t = V::array_from_fn(|_| 0.0);
         for chunk in 0..self.tile.packets.len().div_ceil(V::LANES) {
             let mut maybe =
                 if self.cull { self.batch.maybe_inside::<V>(chunk, &grown, self.reach, SPLIT_SLACK) } else { u32::MAX };
@@ -253,27 +232,9 @@ impl<V: Vf32> FrustumLeaf for BundleEdges<'_, V> {
                     continue;
                 }
                 stats.packets_tested += 1;
+                stats.isect_tests += ids.len() as u64;
                 let (x0, y0) = self.tile.origin_pixel[j];
-                for &id in ids {
-                    stats.isect_tests += 1;
-                    let corners = tris.get(id);
-                    let (hit, t_hit) = crossing_packet(p, corners, active);
-                    if hit.none() {
-                        continue;
-                    }
-                    t_hit.write_to(t.as_mut());
-                    let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-                    let mut bits = hit.bits();
-                    while bits != 0 {
-                        let i = bits.trailing_zeros() as usize;
-                        bits &= bits - 1;
-                        let state = &mut self.states[(y0 + i / pw) * width + x0 + i % pw];
-                        if !state.seen(id) {
-                            let dir = Vec3::new(p.dir[0].lane(i), p.dir[1].lane(i), p.dir[2].lane(i));
-                            state.add(Crossing { t: t.as_ref()[i], tri: id, front: n.dot(dir) < 0.0 });
-                        }
-                    }
-                }
+                leaf_crossings(self.tree, p, ids, active, self.states, |i| (y0 + i / pw) * width + x0 + i % pw);
             }
         }
         (f32::INFINITY, false)
@@ -284,4 +245,42 @@ impl<V: Vf32> FrustumLeaf for BundleEdges<'_, V> {
 #[inline(always)]
 fn lane_bits(count: usize) -> u32 {
     if count >= 32 { u32::MAX } else { (1u32 << count) - 1 }
+}
+
+/// Tests the `active` lanes of `p` against triangles `ids` and adds each crossing to its lane's state,
+/// `states[slot(lane)]`, once per ray (a triangle referenced by several leaves is met in each). Returns the
+/// lanes that got a new crossing.
+#[inline(always)]
+fn leaf_crossings<V: Vf32>(
+    tree: &KdTree,
+    p: &RayPacket<V>,
+    ids: &[u32],
+    active: V::Mask,
+    states: &mut [EdgeWidth],
+    slot: impl Fn(usize) -> usize,
+) -> u32 {
+    let tris = tree.triangles();
+    let mut t = V::array_from_fn(|_| 0.0);
+    let mut added = 0;
+    for &id in ids {
+        let corners = tris.get(id);
+        let (hit, t_hit) = crossing_packet(p, corners, active);
+        if hit.none() {
+            continue;
+        }
+        t_hit.write_to(t.as_mut());
+        let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+        let mut bits = hit.bits();
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let state = &mut states[slot(i)];
+            if !state.seen(id) {
+                let dir = Vec3::new(p.dir[0].lane(i), p.dir[1].lane(i), p.dir[2].lane(i));
+                state.add(Crossing { t: t.as_ref()[i], tri: id, front: n.dot(dir) < 0.0 });
+                added |= 1 << i;
+            }
+        }
+    }
+    added
 }
