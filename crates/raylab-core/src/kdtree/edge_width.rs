@@ -124,7 +124,8 @@ impl KdTree {
         let light = f.origin();
         let o = [V::splat(light.x), V::splat(light.y), V::splat(light.z)];
         let mut seen_from_light = Vec::with_capacity(tile.packets.len());
-        let mut reach = Vec::with_capacity(tile.packets.len().div_ceil(V::LANES) * V::LANES);
+        let chunked = tile.packets.len().div_ceil(V::LANES) * V::LANES;
+        let mut reach = Vec::with_capacity(chunked);
         for (j, p) in tile.packets.iter().enumerate() {
             tile.for_each_lane(j, |k, _| states[k].begin());
             let rays = p.valid.bits().count_ones() as u64;
@@ -135,7 +136,7 @@ impl KdTree {
             seen_from_light.push(RayPacket::from_lanes(o, dir, V::splat(0.0), V::splat(1.0), p.valid.bits()));
             reach.push(if rays > 0 { 1.0 } else { f32::NEG_INFINITY });
         }
-        reach.resize(reach.capacity(), f32::NEG_INFINITY);
+        reach.resize(chunked, f32::NEG_INFINITY);
         let batch = BatchCull::new(light, &seen_from_light);
         let mut walk =
             BundleEdges { tree: self, tile, cull, batch: &batch, reach: &reach, pad: f.origin_slack(), states };

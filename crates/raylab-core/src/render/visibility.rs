@@ -3,8 +3,9 @@
 //! Hard shadows go through the frame's traversal method as one tile of segments ending at the light (so the
 //! frustum methods trace them as frustums from the light, as the thesis does); the shadow cache is a
 //! single-ray technique (DACRT, which traces sets, consults the cache for a whole layer at once); edge widths
-//! start as hard shadows, and the blocked segments then walk the kd-tree for their widths, in packets except
-//! under the single-ray methods; multi-sampling traces each point's samples as one bundle: plain packets
+//! start as hard shadows, and the blocked segments then walk the kd-tree for their widths: one ray at a time
+//! under the single-ray methods, as one frustum or cone from the light for a tile with many of them under
+//! the bundled methods, else in packets; multi-sampling traces each point's samples as one bundle: plain packets
 //! (shared by neighbouring points when their samples are fewer than a packet's lanes), a pyramid fitted to
 //! them, or a pyramid or cone around the light built before the samples ([`crate::trace::Proxy`]).
 
