@@ -134,17 +134,24 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
         .collect();
 
     let mut rgba = vec![[0, 0, 0, 255]; (w * h) as usize];
-    let mut stats = TraversalStats::default();
-    let mut stages = StageTimes::default();
     let range = settings.view.is_scalar().then(|| value_range(&done, settings));
-    for t in done {
-        for (i, c, v) in t.pixels {
-            rgba[i as usize] = match (settings.view, range) {
-                (FrameView::Depth, Some((near, far))) => depth_color(v, near, far),
+    // The tiles are put in place band by band in parallel: a band of `tile` rows holds exactly one row of
+    // tiles, which arrive in row-major order. Done serially, this copy was a twentieth of a 1280x720 frame.
+    let band = w as usize * tile as usize;
+    let tiles_across = w.div_ceil(tile) as usize;
+    rgba.par_chunks_mut(band).zip(done.par_chunks(tiles_across)).enumerate().for_each(|(k, (out, row))| {
+        let start = k * band;
+        for (i, c, v) in row.iter().flat_map(|t| &t.pixels) {
+            out[*i as usize - start] = match (settings.view, range) {
+                (FrameView::Depth, Some((near, far))) => depth_color(*v, near, far),
                 (_, Some((_, hot))) => heat_color(if hot > 0.0 { v / hot } else { 0.0 }),
-                _ => c,
+                _ => *c,
             };
         }
+    });
+    let mut stats = TraversalStats::default();
+    let mut stages = StageTimes::default();
+    for t in &done {
         stats += t.stats;
         stages += t.stages;
     }

@@ -141,7 +141,7 @@ impl Scene {
 
     /// The shading normal at a hit: interpolated vertex normals when the scene has them, else the geometric
     /// normal. Not flipped toward the viewer.
-    #[inline]
+    #[inline(always)]
     pub fn shading_normal(&self, hit: &Hit) -> Vec3 {
         // The builder keeps the normals only when there is one per position.
         if !self.normals.is_empty() {
