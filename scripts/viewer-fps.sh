@@ -30,7 +30,7 @@ cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$table"
 for size in 1280x720 512x512; do
-  for cfg in mft:8 mft:16 frustum:16 packet:16 mono:16; do
+  for cfg in mft:8 mft:16 mft:32 frustum:16 packet:16 mono:16; do
     method=${cfg%%:*}; tile=${cfg##*:}
     w=${size%%x*}; h=${size##*x}
     stats="$work/$method-$tile-$size.json"
