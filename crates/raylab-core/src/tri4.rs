@@ -90,10 +90,12 @@ pub fn closest_in_leaf<V: Vf32>(
         while bits != 0 {
             let lane = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let t = h.t.lane(lane);
-            if t <= *best_t {
+            let (t, tri) = (h.t.lane(lane), ids[4 * b + lane]);
+            // The block was tested against the best hit before its first lane, so a later lane may lie
+            // beyond an earlier one; equal distances go to the lower triangle id, as in the reference.
+            if t < *best_t || (t == *best_t && best.is_none_or(|b| tri < b.tri)) {
                 *best_t = t;
-                *best = Some(Hit { t, tri: ids[4 * b + lane], u: h.u.lane(lane), v: h.v.lane(lane) });
+                *best = Some(Hit { t, tri, u: h.u.lane(lane), v: h.v.lane(lane) });
             }
         }
     }

@@ -46,3 +46,47 @@ fn closed_meshes_never_leak() {
         }
     }
 }
+
+/// A ray through the edge two triangles share meets both at the same distance; every method keeps the
+/// lower triangle id, as the brute-force reference does, whichever of the two it tests first.
+#[test]
+fn a_shared_edge_goes_to_the_lower_triangle_id() {
+    use raylab_core::dacrt::Dacrt;
+    use raylab_core::mbvh::Mbvh;
+    use raylab_core::method::Method;
+    use raylab_core::trace::{TraceOptions, Tracer};
+    use raylab_simd::Backend;
+    let (a, b, c, d) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::ONE);
+    for flip in [false, true] {
+        let mut m = MeshBuilder::new();
+        // Triangle 0 and 1 share the edge b-c; `flip` swaps which of them comes first.
+        let (first, second) =
+            if flip { ([b, d.with_z(0.0), c], [a, b, c]) } else { ([a, b, c], [b, d.with_z(0.0), c]) };
+        m.triangle(first[0], first[1], first[2]);
+        m.triangle(second[0], second[1], second[2]);
+        let scene = m.build();
+        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let (mbvh, dacrt) = (Mbvh::build(&scene), Dacrt::new(&scene));
+        let bf = BruteForce::new(&scene);
+        let mut s = TraversalStats::default();
+        // Down onto the edge's midpoint and two other points of it, in a 2x2 tile of identical rays.
+        for p in [Vec3::new(0.5, 0.5, 0.0), Vec3::new(0.25, 0.75, 0.0), Vec3::new(0.875, 0.125, 0.0)] {
+            let ray = Ray::new(p + Vec3::Z, Vec3::NEG_Z);
+            assert_eq!(bf.hit_distance(&ray, 0), bf.hit_distance(&ray, 1), "flip {flip}: not a tie at {p}");
+            assert_eq!(bf.intersect(&ray, &mut s).map(|h| h.tri), Some(0));
+            let rays = [Some(ray); 4];
+            for method in Method::ALL.into_iter().filter(|&m| m != Method::Reference) {
+                for backend in Backend::available() {
+                    let tracer = Tracer::new(&tree, None, TraceOptions { method, backend, ..Default::default() })
+                        .with_mbvh(&mbvh)
+                        .with_dacrt(&dacrt);
+                    let mut hits = [None; 4];
+                    tracer.intersect_tile(&rays, 2, 2, &mut hits, &mut s);
+                    for h in hits {
+                        assert_eq!(h.map(|h| h.tri), Some(0), "flip {flip}, {method} {backend:?} at {p}");
+                    }
+                }
+            }
+        }
+    }
+}

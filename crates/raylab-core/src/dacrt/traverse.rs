@@ -11,7 +11,7 @@ use super::records::{RayRecord, SetBounds, TriRecord, row_lanes};
 use super::split::divide;
 use super::{DacrtParams, TopNode};
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
-use crate::ray::Hit;
+use crate::ray::{Hit, hit_reach};
 use crate::stats::TraversalStats;
 use crate::triangle::TriangleSoup;
 
@@ -81,7 +81,9 @@ impl Answer for Closest<'_> {
                 let best = &mut self.out[r.id as usize];
                 if beats(&h, *best) {
                     *best = Some(h);
-                    r.tmax = h.t;
+                    // Boxes and triangles just past the hit stay in reach (`HIT_SLACK`): a closer hit
+                    // there still wins, and a farther one loses to `beats`.
+                    r.tmax = hit_reach(h.t);
                 }
             }
         }

@@ -13,7 +13,9 @@ use raylab_simd::{VMask, Vf32};
 use super::mono::SPLIT_SLACK;
 use super::{KdNode, KdParams, KdTree};
 use crate::aabb::{Aabb, coord};
+use crate::packet::hit_reach_lanes;
 use crate::packet::{Bundle, PacketTile, intersect_packet, occlude_packet, overlaps_box};
+use crate::ray::hit_reach;
 use crate::stats::TraversalStats;
 
 #[derive(Clone, Copy)]
@@ -101,7 +103,7 @@ pub(super) fn leaf_intersect<V: Vf32, const SLOTS: usize>(
         }
         let p = &tile.packets[j];
         let hits = &mut tile.hits[j];
-        let active = if cull { overlaps_box(p, bounds, hits.t, SPLIT_SLACK) } else { p.valid };
+        let active = if cull { overlaps_box(p, bounds, hit_reach_lanes(hits.t), SPLIT_SLACK) } else { p.valid };
         if active.none() {
             stats.packets_culled += 1;
             continue;
@@ -113,7 +115,7 @@ pub(super) fn leaf_intersect<V: Vf32, const SLOTS: usize>(
             packet_changed |= intersect_packet(p, hits, tree.triangles().get(id), id, active).any();
         }
         if packet_changed {
-            tile.farthest_hit[j] = V::select(p.valid, hits.t, V::splat(f32::NEG_INFINITY)).reduce_max();
+            tile.farthest_hit[j] = hit_reach(V::select(p.valid, hits.t, V::splat(f32::NEG_INFINITY)).reduce_max());
             changed = true;
         }
     }

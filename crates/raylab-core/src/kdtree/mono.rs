@@ -10,7 +10,7 @@
 
 use std::ops::Range;
 
-use crate::ray::{Hit, Ray};
+use crate::ray::{Hit, Ray, hit_reach};
 use crate::stats::TraversalStats;
 use crate::triangle::RayShear;
 
@@ -49,12 +49,15 @@ impl KdTree {
         self.traverse(ray, stats, |ids, _, _| {
             for &id in &self.tri_ids()[ids] {
                 tests += 1;
-                if let Some(h) = shear.intersect(self.triangles().get(id), ray.tmin, best_t) {
+                // Equal distances go to the lower triangle id, as in the brute-force reference.
+                if let Some(h) = shear.intersect(self.triangles().get(id), ray.tmin, best_t)
+                    && (h.t < best_t || (h.t == best_t && best.is_none_or(|b| id < b.tri)))
+                {
                     best_t = h.t;
                     best = Some(Hit { t: h.t, tri: id, u: h.u, v: h.v });
                 }
             }
-            Next::Continue(best_t)
+            Next::Continue(hit_reach(best_t))
         });
         stats.isect_tests += tests;
         best

@@ -80,7 +80,7 @@ impl<V: Vf32> PacketLeaf<V> for ClosestHits<'_, V> {
             self.tests += 1;
             intersect_packet(self.p, self.hits, self.tree.triangles().get(id), id, active);
         }
-        (self.hits.t, V::Mask::from_bits(0))
+        (crate::packet::hit_reach_lanes(self.hits.t), V::Mask::from_bits(0))
     }
 }
 

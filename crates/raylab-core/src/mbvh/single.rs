@@ -14,7 +14,7 @@ use raylab_simd::{VMask, Vf32};
 
 use super::Mbvh;
 use super::node::MbvhNode;
-use crate::ray::{Hit, Ray};
+use crate::ray::{Hit, Ray, hit_reach};
 use crate::stats::TraversalStats;
 use crate::tri4::{self, ShearX4};
 use crate::triangle::RayShear;
@@ -94,7 +94,7 @@ impl Mbvh {
         let mut leaf = |slots: Range<usize>, limit: &mut f32| {
             tests += slots.len() as u64;
             self.closest_in_leaf(&shear, slots, ray.tmin, &mut best_t, &mut best);
-            *limit = best_t;
+            *limit = hit_reach(best_t);
             false
         };
         self.walk_sized::<V>(ray, stats, &mut leaf);

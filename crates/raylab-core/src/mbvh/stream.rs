@@ -22,7 +22,7 @@ use super::Mbvh;
 use super::node::MbvhNode;
 use super::single::FAR_SLACK;
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
-use crate::ray::{Hit, Ray};
+use crate::ray::{Hit, Ray, hit_reach};
 use crate::stats::TraversalStats;
 use crate::tri4::ShearX4;
 use crate::triangle::RayShear;
@@ -108,6 +108,21 @@ fn keep_open(ids: &mut [u32], hot: &[Hot]) -> usize {
 struct Slot {
     ray: Ray,
     hit: Option<Hit>,
+}
+
+impl Slot {
+    /// The distance a closer hit must beat: the closest hit so far, or the ray's `tmax`.
+    #[inline(always)]
+    fn best_t(&self) -> f32 {
+        self.hit.map_or(self.ray.tmax, |h| h.t)
+    }
+
+    /// The box tests' far limit: `tmax` until a hit is found, then [`hit_reach`] of it, so boxes starting
+    /// just past the hit are still entered (see [`crate::ray::HIT_SLACK`]).
+    #[inline(always)]
+    fn reach(&self) -> f32 {
+        self.hit.map_or(self.ray.tmax, |h| hit_reach(h.t))
+    }
 }
 
 impl Mbvh {
@@ -298,7 +313,9 @@ impl Mbvh {
                 *hot.best_mut() = BLOCKED;
             }
         } else {
-            self.closest_in_leaf(&shear, tri_slots, slot.ray.tmin, hot.best_mut(), &mut slot.hit);
+            let mut best_t = slot.best_t();
+            self.closest_in_leaf(&shear, tri_slots, slot.ray.tmin, &mut best_t, &mut slot.hit);
+            *hot.best_mut() = slot.reach();
         }
         blocks
     }
@@ -313,9 +330,13 @@ impl Mbvh {
         tri_slots: Range<usize>,
         shadow: bool,
     ) -> u64 {
-        // Each lane straight from the slots (every stream ray is valid), limited by its closest hit so far.
+        // Each lane straight from the slots (every stream ray is valid), limited by its closest hit so far
+        // (shadow rays reach leaves only while unblocked, with their own `tmax`).
         let p = RayPacket::<V>::gather(|i| {
-            group.get(i).map(|&id| Ray { tmax: hot[id as usize].best(), ..slots[id as usize].ray })
+            group.get(i).map(|&id| {
+                let slot = &slots[id as usize];
+                Ray { tmax: if shadow { hot[id as usize].best() } else { slot.best_t() }, ..slot.ray }
+            })
         });
         let mut tests = 0;
         if shadow {
@@ -341,9 +362,13 @@ impl Mbvh {
             }
             let found = hits.to_hits();
             for (k, &id) in group.iter().enumerate() {
-                if let Some(h) = found.as_ref()[k] {
-                    *hot[id as usize].best_mut() = h.t;
-                    slots[id as usize].hit = Some(h);
+                let slot = &mut slots[id as usize];
+                // Equal distances go to the lower triangle id, as in the brute-force reference.
+                if let Some(h) = found.as_ref()[k]
+                    && (h.t < slot.best_t() || (h.t == slot.best_t() && slot.hit.is_none_or(|b| h.tri < b.tri)))
+                {
+                    slot.hit = Some(h);
+                    *hot[id as usize].best_mut() = slot.reach();
                 }
             }
         }

@@ -239,3 +239,9 @@ impl<V: Vf32> PacketHits<V> {
         })
     }
 }
+
+/// [`crate::ray::hit_reach`] lane by lane: how far past each lane's best hit cells may still hold a closer one.
+#[inline(always)]
+pub fn hit_reach_lanes<V: Vf32>(t: V) -> V {
+    t.max(t * V::splat(1.0 + crate::ray::HIT_SLACK))
+}

@@ -23,8 +23,9 @@ pub struct PacketTile<V: Vf32> {
     pub packets: Vec<RayPacket<V>>,
     /// Closest hits (or, for occlusion, the per-lane state) of each packet.
     pub hits: Vec<PacketHits<V>>,
-    /// Per packet, the farthest current hit distance over its rays (infinite while one has none): a leaf
-    /// that starts beyond it cannot improve any of the packet's hits. Padded with -inf to whole vectors, so
+    /// Per packet, the farthest current hit distance over its rays (infinite while one has none), widened
+    /// by the kd-tree walks' hit slack once hits are found: a leaf that starts beyond it cannot improve any
+    /// of the packet's hits. Padded with -inf to whole vectors, so
     /// [`BatchCull`] loads it a vector at a time.
     pub farthest_hit: Vec<f32>,
     /// The batched culling data, once [`PacketTile::share_origin`] has found the rays' common origin.

@@ -134,19 +134,36 @@ pub fn intersect_packet<V: Vf32>(
     active: V::Mask,
 ) -> V::Mask {
     let r = test(p, tri, active, hits.t);
-    if r.mask.any() {
-        hits.t = V::select(r.mask, r.t, hits.t);
-        hits.u = V::select(r.mask, r.u, hits.u);
-        hits.v = V::select(r.mask, r.v, hits.v);
-        hits.hit = hits.hit | r.mask;
-        let bits = r.mask.bits();
+    let mut mask = r.mask;
+    if mask.any() {
+        // A hit exactly as far as a lane's current one goes to the lower triangle id, the brute-force
+        // reference's rule, so that every method and visiting order picks the same triangle (two triangles
+        // sharing an edge that a ray meets are hit at the same distance).
+        let ties = mask & r.t.eq(hits.t);
+        if ties.any() {
+            let mut bits = ties.bits();
+            let mut keep = mask.bits();
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if hits.tri.as_ref()[lane] < id {
+                    keep &= !(1 << lane);
+                }
+            }
+            mask = V::Mask::from_bits(keep);
+        }
+        hits.t = V::select(mask, r.t, hits.t);
+        hits.u = V::select(mask, r.u, hits.u);
+        hits.v = V::select(mask, r.v, hits.v);
+        hits.hit = hits.hit | mask;
+        let bits = mask.bits();
         for (i, slot) in hits.tri.as_mut().iter_mut().enumerate() {
             if bits >> i & 1 == 1 {
                 *slot = id;
             }
         }
     }
-    r.mask
+    mask
 }
 
 /// The `active` lanes that meet triangle `tri` within `(tmin, tmax]`, and their distances (for edge-width
