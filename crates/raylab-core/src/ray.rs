@@ -72,9 +72,8 @@ pub struct Hit {
 /// that share an edge: the brute-force reference keeps triangle 9894 at 7.568455, which lies in a kd-tree
 /// cell starting at 7.568793, while triangle 10154 is hit at 7.568769 in the cell before it. A walk that
 /// skipped everything starting beyond its best hit kept 10154 (mono and the packets did), one that happened
-/// to reach 9894's cell first kept 9894 (the frustum methods and the BVHs did), and the BVH methods split
-/// the same way at a few pixels of the forest and kitchen scenes. With the slack every method reaches both
-/// and keeps the closer, as the reference does. It costs a visit only where a hit lies that close to a
+/// to reach 9894's cell first kept 9894 (the frustum methods and the BVHs did). With the slack every method
+/// reaches both and keeps the closer, as the reference does. It costs a visit only where a hit lies that close to a
 /// boundary, and nothing for any-hit walks, which have no best hit.
 pub const HIT_SLACK: f32 = 1e-4;
 
