@@ -9,6 +9,12 @@
 
 use glam::Vec3;
 
+/// Relative slack on the far test made before the division, `t_scaled <= tmax * |det|`. The quotient `t` is
+/// rounded twice and that product once, so without the slack the early test could turn away a hit whose `t`
+/// comes out exactly `tmax`: with `tmax` a ray's best hit, that is a tie, which closest-hit tests resolve by
+/// triangle id. The exact test on `t` after the division decides.
+pub(crate) const SCALED_FAR_SLACK: f32 = 1.0 + 4.0 * f32::EPSILON;
+
 use crate::ray::Ray;
 use crate::scene::Scene;
 
@@ -109,7 +115,7 @@ impl RayShear {
         let t_scaled = u * az + v * bz + w * cz;
         let abs_det = det.abs();
         let t_signed = if det < 0.0 { -t_scaled } else { t_scaled };
-        if !(t_signed > tmin * abs_det && t_signed <= tmax * abs_det) {
+        if !(t_signed > tmin * abs_det && t_signed <= tmax * abs_det * SCALED_FAR_SLACK) {
             return None;
         }
         let inv = 1.0 / det;

@@ -160,10 +160,7 @@ fn coherent_methods_match_brute_force_on_adversarial_rays() {
                         let want = bf.intersect(r, &mut s);
                         let ok = match (hits[i], want) {
                             (None, None) => true,
-                            (Some(g), Some(w)) => {
-                                (g.t - w.t).abs() <= common::T_REL_TOL * w.t.abs()
-                                    && (g.tri == w.tri || bf.hit_distance(r, g.tri) == Some(g.t))
-                            }
+                            (Some(g), Some(w)) => g.tri == w.tri && g.t == w.t,
                             _ => false,
                         };
                         assert!(ok, "{name} {method} {backend:?}: {r:?}: got {:?}, reference {want:?}", hits[i]);

@@ -9,6 +9,7 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
 use super::{PacketHits, RayPacket};
+use crate::triangle::SCALED_FAR_SLACK;
 
 /// Picks component `axis` of `(x, y, z)` per lane, given the lane masks "axis is 0" and "axis is 1".
 #[inline(always)]
@@ -55,7 +56,7 @@ pub(crate) fn sheared_test<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3
     let t_scaled = u * (sz * a_z) + v * (sz * b_z) + w * (sz * c_z);
     let abs_det = det.abs();
     let t_signed = V::select(det.lt(zero), zero - t_scaled, t_scaled);
-    let inside = t_signed.gt(tmin * abs_det) & t_signed.le(tmax * abs_det);
+    let inside = t_signed.gt(tmin * abs_det) & t_signed.le(tmax * abs_det * V::splat(SCALED_FAR_SLACK));
     let inv = V::splat(1.0) / det;
     let t = t_scaled * inv;
     let in_range = t.gt(tmin) & t.le(tmax);
