@@ -42,7 +42,8 @@ struct Task {
 
 /// What the box tests read of a ray, 32 bytes, kept apart from the rest so that a group of 2^12 rays' box
 /// data stays in the L2 cache: two rows of four floats, origin and `tmin`, then inverse direction and the
-/// current far limit (the closest hit so far, or `tmax`; [`BLOCKED`] once a shadow ray is blocked).
+/// current far limit (`tmax`, then [`Slot::reach`] of the closest hit so far; [`BLOCKED`] once a shadow ray
+/// is blocked).
 #[derive(Clone, Copy)]
 #[repr(C, align(32))]
 struct Hot {
@@ -58,16 +59,16 @@ impl Hot {
         Self { rows: [[o.x, o.y, o.z, ray.tmin], [i.x, i.y, i.z, ray.tmax]] }
     }
 
-    fn best(&self) -> f32 {
+    fn limit(&self) -> f32 {
         self.rows[1][3]
     }
 
-    fn best_mut(&mut self) -> &mut f32 {
+    fn limit_mut(&mut self) -> &mut f32 {
         &mut self.rows[1][3]
     }
 
     fn blocked(&self) -> bool {
-        self.best() == BLOCKED
+        self.limit() == BLOCKED
     }
 }
 
@@ -310,12 +311,12 @@ impl Mbvh {
         let blocks = tri_slots.len().div_ceil(4) as u64;
         if shadow {
             if self.blocker_in_leaf(&shear, tri_slots, slot.ray.tmin, slot.ray.tmax).0.is_some() {
-                *hot.best_mut() = BLOCKED;
+                *hot.limit_mut() = BLOCKED;
             }
         } else {
             let mut best_t = slot.best_t();
             self.closest_in_leaf(&shear, tri_slots, slot.ray.tmin, &mut best_t, &mut slot.hit);
-            *hot.best_mut() = slot.reach();
+            *hot.limit_mut() = slot.reach();
         }
         blocks
     }
@@ -335,7 +336,7 @@ impl Mbvh {
         let p = RayPacket::<V>::gather(|i| {
             group.get(i).map(|&id| {
                 let slot = &slots[id as usize];
-                Ray { tmax: if shadow { hot[id as usize].best() } else { slot.best_t() }, ..slot.ray }
+                Ray { tmax: if shadow { hot[id as usize].limit() } else { slot.best_t() }, ..slot.ray }
             })
         });
         let mut tests = 0;
@@ -351,7 +352,7 @@ impl Mbvh {
             let blocked = p.valid.bits() & !open.bits();
             for (k, &id) in group.iter().enumerate() {
                 if blocked >> k & 1 == 1 {
-                    *hot[id as usize].best_mut() = BLOCKED;
+                    *hot[id as usize].limit_mut() = BLOCKED;
                 }
             }
         } else {
@@ -368,7 +369,7 @@ impl Mbvh {
                     && (h.t < slot.best_t() || (h.t == slot.best_t() && slot.hit.is_none_or(|b| h.tri < b.tri)))
                 {
                     slot.hit = Some(h);
-                    *hot[id as usize].best_mut() = slot.reach();
+                    *hot[id as usize].limit_mut() = slot.reach();
                 }
             }
         }
