@@ -63,6 +63,17 @@ pub struct Hit {
     pub v: f32,
 }
 
+impl Hit {
+    /// True when this hit is to replace `best` as a ray's closest hit: it is nearer, or as near with a lower
+    /// triangle id. That is the brute-force reference's rule (it keeps the first of equal hits in id order),
+    /// and every closest-hit kernel applies it, so that two triangles met at the same distance (a shared
+    /// edge, coincident faces) give every method and visiting order the same answer.
+    #[inline(always)]
+    pub fn beats(&self, best: Option<Hit>) -> bool {
+        best.is_none_or(|b| self.t < b.t || (self.t == b.t && self.tri < b.tri))
+    }
+}
+
 /// Relative slack on a ray's best hit when a closest-hit walk decides what could still hold a closer one:
 /// kd-tree cells and BVH boxes that start up to 1e-4 of the distance past the best hit are still entered
 /// (triangles there are tested against the best hit itself, so a farther one never wins).

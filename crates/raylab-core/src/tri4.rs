@@ -90,12 +90,12 @@ pub fn closest_in_leaf<V: Vf32>(
         while bits != 0 {
             let lane = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let (t, tri) = (h.t.lane(lane), ids[4 * b + lane]);
             // The block was tested against the best hit before its first lane, so a later lane may lie
-            // beyond an earlier one; equal distances go to the lower triangle id, as in the reference.
-            if t < *best_t || (t == *best_t && best.is_none_or(|b| tri < b.tri)) {
-                *best_t = t;
-                *best = Some(Hit { t, tri, u: h.u.lane(lane), v: h.v.lane(lane) });
+            // beyond an earlier one.
+            let hit = Hit { t: h.t.lane(lane), tri: ids[4 * b + lane], u: h.u.lane(lane), v: h.v.lane(lane) };
+            if hit.beats(*best) {
+                *best_t = hit.t;
+                *best = Some(hit);
             }
         }
     }

@@ -35,7 +35,7 @@ use crate::stats::TraversalStats;
 use crate::triangle::TriangleSoup;
 use records::{RayRecord, SetBounds, TriRecord};
 use split::Split;
-use traverse::{Answer, Any, Blocker, Closest, Walk, beats};
+use traverse::{Answer, Any, Blocker, Closest, Walk};
 
 /// When DACRT stops dividing and how it divides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -191,7 +191,7 @@ impl Dacrt {
         self.run_forked(p, rays, groups, [Closest { out: &mut *out }, Closest { out: &mut second }], stats);
         for (o, s) in out.iter_mut().zip(second) {
             if let Some(s) = s
-                && beats(&s, *o)
+                && s.beats(*o)
             {
                 *o = Some(s);
             }

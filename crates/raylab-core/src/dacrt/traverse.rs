@@ -54,13 +54,6 @@ impl<A: Answer> Kernel for LeafKernel<'_, A> {
     }
 }
 
-/// True when `h` is to replace `best` as a ray's closest hit: it is nearer, or as near with a lower triangle
-/// id, as in the brute-force reference.
-#[inline(always)]
-pub(super) fn beats(h: &Hit, best: Option<Hit>) -> bool {
-    best.is_none_or(|b| h.t < b.t || (h.t == b.t && h.tri < b.tri))
-}
-
 /// Closest hits, written at each ray's id.
 pub(super) struct Closest<'a> {
     pub out: &'a mut [Option<Hit>],
@@ -79,10 +72,10 @@ impl Answer for Closest<'_> {
             for (r, h) in group.iter_mut().zip(found.as_ref()) {
                 let &Some(h) = h else { continue };
                 let best = &mut self.out[r.id as usize];
-                if beats(&h, *best) {
+                if h.beats(*best) {
                     *best = Some(h);
                     // Boxes and triangles just past the hit stay in reach (`HIT_SLACK`): a closer hit
-                    // there still wins, and a farther one loses to `beats`.
+                    // there still wins, and a farther one loses to `Hit::beats`.
                     r.tmax = hit_reach(h.t);
                 }
             }

@@ -49,12 +49,12 @@ impl KdTree {
         self.traverse(ray, stats, |ids, _, _| {
             for &id in &self.tri_ids()[ids] {
                 tests += 1;
-                // Equal distances go to the lower triangle id, as in the brute-force reference.
-                if let Some(h) = shear.intersect(self.triangles().get(id), ray.tmin, best_t)
-                    && (h.t < best_t || (h.t == best_t && best.is_none_or(|b| id < b.tri)))
-                {
-                    best_t = h.t;
-                    best = Some(Hit { t: h.t, tri: id, u: h.u, v: h.v });
+                if let Some(h) = shear.intersect(self.triangles().get(id), ray.tmin, best_t) {
+                    let h = Hit { t: h.t, tri: id, u: h.u, v: h.v };
+                    if h.beats(best) {
+                        best_t = h.t;
+                        best = Some(h);
+                    }
                 }
             }
             Next::Continue(hit_reach(best_t))

@@ -364,9 +364,8 @@ impl Mbvh {
             let found = hits.to_hits();
             for (k, &id) in group.iter().enumerate() {
                 let slot = &mut slots[id as usize];
-                // Equal distances go to the lower triangle id, as in the brute-force reference.
                 if let Some(h) = found.as_ref()[k]
-                    && (h.t < slot.best_t() || (h.t == slot.best_t() && slot.hit.is_none_or(|b| h.tri < b.tri)))
+                    && h.beats(slot.hit)
                 {
                     slot.hit = Some(h);
                     *hot[id as usize].limit_mut() = slot.reach();

@@ -137,9 +137,8 @@ pub fn intersect_packet<V: Vf32>(
     let r = test(p, tri, active, hits.t);
     let mut mask = r.mask;
     if mask.any() {
-        // A hit exactly as far as a lane's current one goes to the lower triangle id, the brute-force
-        // reference's rule, so that every method and visiting order picks the same triangle (two triangles
-        // sharing an edge that a ray meets are hit at the same distance).
+        // A hit exactly as far as a lane's current one goes to the lower triangle id: `Hit::beats`'s rule,
+        // lane by lane (the test already kept only hits no farther than the current ones).
         let ties = mask & r.t.eq(hits.t);
         if ties.any() {
             let mut bits = ties.bits();
