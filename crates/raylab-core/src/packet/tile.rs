@@ -51,28 +51,56 @@ impl<V: Vf32> PacketTile<V> {
     /// Cuts `rays` (row-major, `width x height`) into packets.
     #[inline(always)]
     pub fn new(rays: &[Option<Ray>], width: usize, height: usize) -> Self {
+        let mut tile = Self::empty();
+        tile.refill(rays, width, height);
+        tile
+    }
+
+    /// A tile without packets, to be filled by [`PacketTile::refill`].
+    pub fn empty() -> Self {
+        Self {
+            packets: Vec::new(),
+            hits: Vec::new(),
+            farthest_hit: Vec::new(),
+            batch: None,
+            origin_pixel: Vec::new(),
+            cols: 0,
+            rows: 0,
+            width: 0,
+            height: 0,
+        }
+    }
+
+    /// [`PacketTile::new`] in place, keeping the buffers: kernels that trace many small tiles one after the
+    /// other (each point's light samples) would otherwise spend as long allocating them as packing the rays.
+    #[inline(always)]
+    pub fn refill(&mut self, rays: &[Option<Ray>], width: usize, height: usize) {
         let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
         let (cols, rows) = (width.div_ceil(pw), height.div_ceil(ph));
-        let mut packets = Vec::with_capacity(cols * rows);
-        let mut origin_pixel = Vec::with_capacity(cols * rows);
+        (self.cols, self.rows, self.width, self.height, self.batch) = (cols, rows, width, height, None);
+        let n = cols * rows;
+        let (packets, origin_pixel, hits, farthest_hit) =
+            (&mut self.packets, &mut self.origin_pixel, &mut self.hits, &mut self.farthest_hit);
+        packets.clear();
+        origin_pixel.clear();
+        hits.clear();
+        farthest_hit.clear();
+        packets.reserve(n);
+        origin_pixel.reserve(n);
+        hits.reserve(n);
         for by in 0..rows {
             for bx in 0..cols {
-                packets.push(RayPacket::gather(|i| {
+                let p = RayPacket::gather(|i| {
                     let (x, y) = (pw * bx + i % pw, ph * by + i / pw);
                     if x < width && y < height { rays[y * width + x] } else { None }
-                }));
+                });
+                hits.push(PacketHits::new(&p));
+                farthest_hit.push(V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max());
+                packets.push(p);
                 origin_pixel.push((pw * bx, ph * by));
             }
         }
-        // Plain loops: vector code must be inlined into the SIMD entry point (see `map3`).
-        let mut hits = Vec::with_capacity(packets.len());
-        let mut farthest_hit = Vec::with_capacity(packets.len());
-        for p in &packets {
-            hits.push(PacketHits::new(p));
-            farthest_hit.push(V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max());
-        }
-        farthest_hit.resize(packets.len().div_ceil(V::LANES) * V::LANES, f32::NEG_INFINITY);
-        Self { packets, hits, farthest_hit, batch: None, origin_pixel, cols, rows, width, height }
+        farthest_hit.resize(n.div_ceil(V::LANES) * V::LANES, f32::NEG_INFINITY);
     }
 
     /// Prepares batched packet/leaf culling ([`BatchCull`]) for rays that all start at `origin` (the caller

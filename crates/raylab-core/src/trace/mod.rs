@@ -444,8 +444,8 @@ impl<'a> Tracer<'a> {
         out: &mut [bool],
         stats: &mut TraversalStats,
     ) {
-        let TileScratch { all, blocked, stack } = scratch;
-        let mut tile = PacketTile::<V>::new(rays, width, height);
+        let TileScratch { all, blocked, stack, tile } = scratch;
+        tile.refill(rays, width, height);
         blocked.clear();
         blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
         all.clear();
@@ -453,11 +453,11 @@ impl<'a> Tracer<'a> {
         let all = &all[..];
         if self.options.cull
             && self.options.method.is_bundled()
-            && let Some(origin) = common_origin(&tile, all)
+            && let Some(origin) = common_origin(tile, all)
         {
             tile.share_origin(origin);
         }
-        let tile = &tile;
+        let tile = &*tile;
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         // Packets no bundle covers are traced as packets afterwards: all of them, or the quadrants' rest.
@@ -615,8 +615,8 @@ impl Kernel for OccludedSimd<'_, '_> {
 }
 
 /// The buffers of a tile's occlusion walk ([`Tracer::occluded_simd`], [`Tracer::occluded_in_proxy_simd`]),
-/// kept by kernels that trace many small tiles so that each does not allocate them anew. (The packets are
-/// cut anew for each tile: refilling a kept [`PacketTile`] made the packet walks over it slower.)
+/// kept by kernels that trace many small tiles (a point's light samples) so that each does not allocate
+/// them anew: cut anew, a 16-sample tile's packets cost more than its proxy walk.
 pub(crate) struct TileScratch<V: Vf32> {
     /// Indices of the packets that take part in the walk.
     pub all: Vec<usize>,
@@ -624,11 +624,13 @@ pub(crate) struct TileScratch<V: Vf32> {
     pub blocked: Vec<V::Mask>,
     /// The stack of packets traced alone.
     pub stack: PacketStack<V>,
+    /// The tile of packets, refilled for each bundle ([`PacketTile::refill`]).
+    pub tile: PacketTile<V>,
 }
 
 impl<V: Vf32> Default for TileScratch<V> {
     fn default() -> Self {
-        Self { all: Vec::new(), blocked: Vec::new(), stack: PacketStack::default() }
+        Self { all: Vec::new(), blocked: Vec::new(), stack: PacketStack::default(), tile: PacketTile::empty() }
     }
 }
 

@@ -10,7 +10,7 @@ use glam::Vec3;
 use raylab_simd::{Kernel, VMask, Vf32};
 
 use crate::method::Method;
-use crate::packet::{Cone, Frustum, PacketTile};
+use crate::packet::{Cone, Frustum};
 use crate::ray::Ray;
 use crate::stats::TraversalStats;
 
@@ -91,8 +91,9 @@ impl Tracer<'_> {
         out: &mut [bool],
         stats: &mut TraversalStats,
     ) {
-        let TileScratch { all, blocked, .. } = scratch;
-        let tile = &PacketTile::<V>::new(rays, width, height);
+        let TileScratch { all, blocked, tile, .. } = scratch;
+        tile.refill(rays, width, height);
+        let tile = &*tile;
         // Plain loops: vector code must be inlined into the SIMD entry point (see `map3`).
         all.clear();
         for (j, p) in tile.packets.iter().enumerate() {
