@@ -616,7 +616,8 @@ impl Kernel for OccludedSimd<'_, '_> {
 
 /// The buffers of a tile's occlusion walk ([`Tracer::occluded_simd`], [`Tracer::occluded_in_proxy_simd`]),
 /// kept by kernels that trace many small tiles (a point's light samples) so that each does not allocate
-/// them anew: cut anew, a 16-sample tile's packets cost more than its proxy walk.
+/// them anew (cut anew, a 16-sample tile's packets cost two thirds as much as its proxy walk;
+/// docs/BENCHMARKS.md, shading readings).
 pub(crate) struct TileScratch<V: Vf32> {
     /// Indices of the packets that take part in the walk.
     pub all: Vec<usize>,
