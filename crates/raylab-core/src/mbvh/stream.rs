@@ -306,6 +306,9 @@ impl Mbvh {
     }
 
     /// Tests one ray against the leaf's triangles, four at a time; returns the number of block tests.
+    /// Inlined, like every vector kernel here, so that it is compiled with the entry point's instruction set
+    /// (out of line it was built for the x86-64 baseline, SSE2 without VEX).
+    #[inline(always)]
     fn leaf_single<V: Vf32>(&self, hot: &mut Hot, slot: &mut Slot, tri_slots: Range<usize>, shadow: bool) -> u64 {
         let shear = ShearX4::<V>::new(&RayShear::new(&slot.ray));
         let blocks = tri_slots.len().div_ceil(4) as u64;
@@ -322,7 +325,8 @@ impl Mbvh {
     }
 
     /// Tests up to four rays, packed into a temporary SoA packet, against the leaf's triangles; returns the
-    /// number of packet/triangle tests.
+    /// number of packet/triangle tests. Inlined for the entry point's instruction set, as [`Self::leaf_single`].
+    #[inline(always)]
     fn leaf_packet<V: Vf32>(
         &self,
         hot: &mut [Hot],
