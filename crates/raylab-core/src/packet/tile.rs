@@ -72,7 +72,8 @@ impl<V: Vf32> PacketTile<V> {
     }
 
     /// [`PacketTile::new`] in place, keeping the buffers: kernels that trace many small tiles one after the
-    /// other (each point's light samples) would otherwise spend as long allocating them as packing the rays.
+    /// other (each point's light samples) would otherwise spend several times as long allocating them as
+    /// packing the rays (docs/BENCHMARKS.md, shading readings).
     #[inline(always)]
     pub fn refill(&mut self, rays: &[Option<Ray>], width: usize, height: usize) {
         let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
