@@ -388,6 +388,55 @@ fn sign_crossing(dist: f32, slack: f32, [pos_near, pos_far, neg_near, neg_far]: 
 mod tests {
     use super::*;
 
+    /// Rays of a `width x height` tile, some missing, so packets have empty lanes.
+    fn tile_rays(width: usize, height: usize, seed: f32) -> Vec<Option<Ray>> {
+        (0..width * height)
+            .map(|i| {
+                let f = i as f32 + seed;
+                let dir = Vec3::new((f * 0.37).sin(), (f * 0.11).cos(), 1.0).normalize();
+                (i % 7 != 3).then(|| Ray::segment(Vec3::new(seed, 1.0, -2.0), dir, 0.0, 10.0 + f))
+            })
+            .collect()
+    }
+
+    /// A tile refilled after holding a larger and a smaller one equals the tile cut anew from the same rays
+    /// (a [`raylab_simd::Kernel`], so every backend's lane type is checked).
+    struct RefillEqualsNew;
+
+    impl raylab_simd::Kernel for RefillEqualsNew {
+        type Output = ();
+        fn run<V: Vf32>(self) {
+            let mut kept = PacketTile::<V>::empty();
+            for (w, h, seed) in [(16, 16, 0.5), (4, 4, 1.5), (5, 3, 2.5), (0, 0, 3.5), (9, 6, 4.5)] {
+                let rays = tile_rays(w, h, seed);
+                kept.refill(&rays, w, h);
+                kept.share_origin(Vec3::new(seed, 1.0, -2.0));
+                kept.refill(&rays, w, h);
+                let new = PacketTile::<V>::new(&rays, w, h);
+                let dims = |t: &PacketTile<V>| (t.cols, t.rows, t.width, t.height);
+                assert_eq!(dims(&kept), dims(&new), "{w}x{h}");
+                assert!(kept.batch.is_none(), "{w}x{h}: a refill drops the old batch data");
+                assert_eq!(kept.origin_pixel, new.origin_pixel, "{w}x{h}");
+                assert_eq!(kept.farthest_hit, new.farthest_hit, "{w}x{h}");
+                assert_eq!((kept.packets.len(), kept.hits.len()), (new.packets.len(), new.hits.len()));
+                for (j, (a, b)) in kept.packets.iter().zip(&new.packets).enumerate() {
+                    assert_eq!(a.valid.bits(), b.valid.bits(), "{w}x{h} packet {j}");
+                    for i in (0..V::LANES).filter(|i| a.valid.bits() >> i & 1 == 1) {
+                        assert_eq!(a.ray(i), b.ray(i), "{w}x{h} packet {j} lane {i}");
+                        assert_eq!(kept.hits[j].t.lane(i), new.hits[j].t.lane(i), "{w}x{h} packet {j} lane {i}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn refilled_tiles_equal_new_ones_on_every_backend() {
+        for backend in raylab_simd::Backend::available() {
+            raylab_simd::dispatch(backend, RefillEqualsNew);
+        }
+    }
+
     #[test]
     fn crossing_bounds_every_ray() {
         let o = Vec3::new(0.5, -1.0, 2.0);
