@@ -128,7 +128,8 @@ pub enum Backend {
     Scalar,
     /// SSE2 on x86-64 (always present there): four lanes.
     Sse,
-    /// AVX2 and FMA on x86-64 CPUs that have them (checked at run time): eight lanes for the kernels that
+    /// AVX2 and FMA on x86-64 CPUs that have them, with the bit-manipulation sets every such CPU has (BMI1,
+    /// BMI2, POPCNT, LZCNT; all checked at run time): eight lanes for the kernels that
     /// take any width (4x2 ray packets, DACRT's filter and leaves) and two rays per four-wide node test in
     /// MBVH ray streams; single-ray MBVH traversal, whose vectors are its four-wide nodes, uses SSE with it.
     Avx2,
@@ -210,11 +211,12 @@ pub trait Kernel {
 pub fn dispatch<K: Kernel>(backend: Backend, k: K) -> K::Output {
     match backend {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the guard checked that the CPU has AVX-512F/VL, AVX2 and FMA, every feature `run_avx512` is
-        // compiled for.
+        // SAFETY: the guard checked that the CPU has AVX-512F/VL, AVX2, FMA and the bit-manipulation sets,
+        // every feature `run_avx512` is compiled for.
         Backend::Avx512 if avx512_detected() => unsafe { run_avx512(k) },
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the guard checked that the CPU has AVX2 and FMA, every feature `run_avx2` is compiled for.
+        // SAFETY: the guard checked that the CPU has AVX2, FMA and the bit-manipulation sets, every feature
+        // `run_avx2` is compiled for.
         Backend::Avx2 | Backend::Avx512 if avx2_detected() => unsafe { run_avx2(k) },
         #[cfg(target_arch = "x86_64")]
         Backend::Sse | Backend::Avx2 | Backend::Avx512 => k.run::<sse::F32x4>(),
@@ -222,31 +224,38 @@ pub fn dispatch<K: Kernel>(backend: Backend, k: K) -> K::Output {
     }
 }
 
-/// True when this CPU has AVX-512F and AVX-512VL besides AVX2 and FMA ([`Backend::Avx512`]).
+/// True when this CPU has AVX-512F and AVX-512VL besides what [`Backend::Avx2`] needs ([`Backend::Avx512`]).
 #[cfg(target_arch = "x86_64")]
 fn avx512_detected() -> bool {
     is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") && avx2_detected()
 }
 
-/// True when this CPU has AVX2 and FMA ([`Backend::Avx2`]).
+/// True when this CPU has AVX2 and FMA, and BMI1, BMI2, POPCNT and LZCNT ([`Backend::Avx2`]). Every CPU with
+/// AVX2 has the four (Intel from Haswell, AMD from Excavator); compiling the entry points for them turns the
+/// kernels' scalar mask work (lane bits, variable shifts, bit counts) into single instructions.
 #[cfg(target_arch = "x86_64")]
 fn avx2_detected() -> bool {
-    is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
+    is_x86_feature_detected!("avx2")
+        && is_x86_feature_detected!("fma")
+        && is_x86_feature_detected!("bmi1")
+        && is_x86_feature_detected!("bmi2")
+        && is_x86_feature_detected!("popcnt")
+        && is_x86_feature_detected!("lzcnt")
 }
 
-/// Runs `k` with eight lanes, compiled for AVX2 and FMA, so the kernel's inlined code and [`x8::F32x8`]'s
-/// intrinsics become 256-bit instructions. The only place an `F32x8` is created (see the `x8` module).
+/// Runs `k` with eight lanes, compiled for AVX2, FMA and the bit-manipulation sets, so the kernel's inlined
+/// code and [`x8::F32x8`]'s intrinsics become 256-bit instructions. The only place an `F32x8` is created (see the `x8` module).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,popcnt,lzcnt")]
 fn run_avx2<K: Kernel>(k: K) -> K::Output {
     k.run::<x8::F32x8>()
 }
 
-/// Runs `k` with sixteen lanes, compiled for AVX-512F/VL, AVX2 and FMA, so the kernel's inlined code and
+/// Runs `k` with sixteen lanes, compiled for AVX-512F/VL and all `run_avx2` is, so the kernel's inlined code and
 /// [`x16::F32x16`]'s intrinsics become 512-bit instructions. The only place an `F32x16` is created (see the
 /// `x16` module).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma,bmi1,bmi2,popcnt,lzcnt")]
 fn run_avx512<K: Kernel>(k: K) -> K::Output {
     k.run::<x16::F32x16>()
 }
@@ -351,7 +360,11 @@ mod tests {
         {
             assert!(avail.contains(&Backend::Sse));
             assert_eq!(Backend::Sse.lanes(), 4);
-            let eight = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
+            let bits = is_x86_feature_detected!("bmi1")
+                && is_x86_feature_detected!("bmi2")
+                && is_x86_feature_detected!("popcnt")
+                && is_x86_feature_detected!("lzcnt");
+            let eight = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") && bits;
             assert_eq!(avail.contains(&Backend::Avx2), eight);
             assert_eq!(Backend::Avx2.lanes(), if eight { 8 } else { 4 }, "without AVX2 the backend falls back");
             let sixteen = eight && is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl");
