@@ -244,16 +244,17 @@ fn avx2_detected() -> bool {
 }
 
 /// Runs `k` with eight lanes, compiled for AVX2, FMA and the bit-manipulation sets, so the kernel's inlined
-/// code and [`x8::F32x8`]'s intrinsics become 256-bit instructions. The only place an `F32x8` is created (see the `x8` module).
+/// code and [`x8::F32x8`]'s intrinsics become 256-bit instructions. The only place an `F32x8` is created
+/// (see the `x8` module).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,bmi1,bmi2,popcnt,lzcnt")]
 fn run_avx2<K: Kernel>(k: K) -> K::Output {
     k.run::<x8::F32x8>()
 }
 
-/// Runs `k` with sixteen lanes, compiled for AVX-512F/VL and all `run_avx2` is, so the kernel's inlined code and
-/// [`x16::F32x16`]'s intrinsics become 512-bit instructions. The only place an `F32x16` is created (see the
-/// `x16` module).
+/// Runs `k` with sixteen lanes, compiled for AVX-512F/VL besides every feature of `run_avx2`, so the kernel's
+/// inlined code and [`x16::F32x16`]'s intrinsics become 512-bit instructions. The only place an `F32x16` is
+/// created (see the `x16` module).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2,fma,bmi1,bmi2,popcnt,lzcnt")]
 fn run_avx512<K: Kernel>(k: K) -> K::Output {

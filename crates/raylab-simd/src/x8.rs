@@ -4,8 +4,8 @@
 //!
 //! The types are private to this crate and only [`crate::dispatch`]'s AVX2 entry point instantiates kernels
 //! with them, after checking that the CPU has AVX2 and FMA (and the bit-manipulation sets): no value of them,
-//! and so none of the AVX instructions below, can exist on a CPU without those features. Kernels are inlined into that entry point,
-//! which is compiled for AVX2, so every operation becomes one 256-bit instruction.
+//! and so none of the AVX instructions below, can exist on a CPU without those features. Kernels are inlined
+//! into that entry point, which is compiled for AVX2, so every operation becomes one 256-bit instruction.
 
 use std::arch::x86_64::*;
 use std::fmt::Debug;
