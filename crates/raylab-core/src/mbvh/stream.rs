@@ -85,13 +85,26 @@ fn test_boxes<B: Vf32>(node: &MbvhNode, rays: &[&Hot]) -> (B, B::Mask) {
     for a in 0..3 {
         let lo = (B::repeat4(&node.min[a]) - org[a]) * inv[a];
         let hi = (B::repeat4(&node.max[a]) - org[a]) * inv[a];
-        // An inverse is never NaN or -0 for a valid ray, so "not negative" is its sign bit.
-        let pos = !inv[a].lt(zero);
+        // An inverse is never NaN or -0 for a valid ray, so "negative" is its sign bit.
+        let neg = inv[a].lt(zero);
         // SSE rule: a NaN entry/exit (origin on the plane, zero direction) keeps the other operand.
-        near = B::select(pos, lo, hi).max(near);
-        far = B::select(pos, hi, lo).min(far);
+        near = B::select(neg, hi, lo).max(near);
+        far = B::select(neg, lo, hi).min(far);
     }
     (near, near.le(far * B::splat(FAR_SLACK)))
+}
+
+/// Writes each ray of `group` onto all four lane stacks at their tops and keeps it (advances the top) where
+/// its bit in `bits` is set (ray `j`'s bits are `4j..4j + 4`, lane by lane): a write without a branch on
+/// whether the ray hit the lane's box.
+#[inline(always)]
+fn push_hits(stacks: &mut [&mut [u32]; 4], tops: &mut [usize; 4], group: &[u32], bits: u32) {
+    for (j, &id) in group.iter().enumerate() {
+        for (k, stack) in stacks.iter_mut().enumerate() {
+            stack[tops[k]] = id;
+            tops[k] += (bits >> (4 * j + k) & 1) as usize;
+        }
+    }
 }
 
 /// Moves the ids of the rays in `ids` not yet blocked to its front, in order; returns how many there are.
@@ -202,6 +215,7 @@ impl Mbvh {
         let mut top = [ids.len(), 0, 0, 0];
         let mut lanes: [Vec<u32>; 4] = [ids, Vec::new(), Vec::new(), Vec::new()];
         let mut tasks: Vec<Task> = vec![Task { child: 0, tris: 0, lane: 0, count: n }];
+        let mut scratch: Vec<u32> = Vec::with_capacity(n as usize);
         let (mut fetches, mut box_tests, mut leaves, mut tests) = (0u64, 0u64, 0u64, 0u64);
         let (mut leaf_rays, mut slots4, mut slots8, mut slots16) = (0u64, 0u64, 0u64, 0u64);
         while let Some(task) = tasks.pop() {
@@ -244,30 +258,30 @@ impl Mbvh {
                 }
             }
             box_tests += (end - start) as u64;
-            // The task's rays are read from their lane's stack while the hits are pushed onto all four, in
-            // place: a lane's stack top never passes the next ray to read, since each ray pushes at most one
-            // entry per lane. The tops live in a local copy, indexed only by constants, so they stay in
-            // registers.
+            // The task's rays are copied out of their lane's stack, then tested a test's worth at a time (two
+            // rays with eight lanes) and pushed onto the stack of every lane whose box they hit. The tops live
+            // in a local copy, indexed only by constants, so they stay in registers.
+            scratch.clear();
+            scratch.extend_from_slice(&lanes[lane][start..end]);
+            let [l0, l1, l2, l3] = &mut lanes;
+            let mut stacks = [&mut l0[..], &mut l1[..], &mut l2[..], &mut l3[..]];
             let mut tops = top;
             let mut lengths = B::splat(0.0);
             let per_test = B::LANES / 4;
-            let mut r = start;
-            while r < end {
-                let count = per_test.min(end - r);
-                let group = [lanes[lane][r], lanes[lane][r + count - 1]];
-                let rays = [&hot[group[0] as usize], &hot[group[1] as usize]];
+            let mut groups = scratch.chunks_exact(per_test);
+            for group in &mut groups {
+                let rays = [&hot[group[0] as usize], &hot[group[per_test - 1] as usize]];
                 let (near, hit) = test_boxes::<B>(node, &rays[..per_test]);
-                // A lone last ray fills both halves; only its first counts.
-                let hit = hit & B::Mask::from_bits((1 << (4 * count)) - 1);
                 lengths = lengths + B::select(hit, near, B::splat(0.0));
-                let bits = hit.bits();
-                for (j, &id) in group[..count].iter().enumerate() {
-                    for (k, stack) in lanes.iter_mut().enumerate() {
-                        stack[tops[k]] = id;
-                        tops[k] += (bits >> (4 * j + k) & 1) as usize;
-                    }
-                }
-                r += count;
+                push_hits(&mut stacks, &mut tops, group, hit.bits());
+            }
+            if let &[id] = groups.remainder() {
+                // A lone last ray fills both halves; only its first counts.
+                let ray = &hot[id as usize];
+                let (near, hit) = test_boxes::<B>(node, &[ray, ray][..per_test]);
+                let hit = hit & B::Mask::from_bits(0xF);
+                lengths = lengths + B::select(hit, near, B::splat(0.0));
+                push_hits(&mut stacks, &mut tops, &[id], hit.bits());
             }
             let pushed: [usize; 4] = std::array::from_fn(|k| tops[k] - top[k]);
             top = tops;
