@@ -215,7 +215,6 @@ impl Mbvh {
         let mut top = [ids.len(), 0, 0, 0];
         let mut lanes: [Vec<u32>; 4] = [ids, Vec::new(), Vec::new(), Vec::new()];
         let mut tasks: Vec<Task> = vec![Task { child: 0, tris: 0, lane: 0, count: n }];
-        let mut scratch: Vec<u32> = Vec::with_capacity(n as usize);
         let (mut fetches, mut box_tests, mut leaves, mut tests) = (0u64, 0u64, 0u64, 0u64);
         let (mut leaf_rays, mut slots4, mut slots8, mut slots16) = (0u64, 0u64, 0u64, 0u64);
         while let Some(task) = tasks.pop() {
@@ -258,25 +257,27 @@ impl Mbvh {
                 }
             }
             box_tests += (end - start) as u64;
-            // The task's rays are copied out of their lane's stack, then tested a test's worth at a time (two
-            // rays with eight lanes) and pushed onto the stack of every lane whose box they hit. The tops live
-            // in a local copy, indexed only by constants, so they stay in registers.
-            scratch.clear();
-            scratch.extend_from_slice(&lanes[lane][start..end]);
+            // The task's rays are read from their lane's stack a test's worth at a time (two rays with eight
+            // lanes) while each is pushed onto the stack of every lane whose box it hits, in place: a lane's
+            // top never passes the next ray to read, since each ray pushes at most one entry per lane. The
+            // tops live in a local copy, indexed only by constants, so they stay in registers.
             let [l0, l1, l2, l3] = &mut lanes;
             let mut stacks = [&mut l0[..], &mut l1[..], &mut l2[..], &mut l3[..]];
             let mut tops = top;
             let mut lengths = B::splat(0.0);
             let per_test = B::LANES / 4;
-            let mut groups = scratch.chunks_exact(per_test);
-            for group in &mut groups {
-                let rays = [&hot[group[0] as usize], &hot[group[per_test - 1] as usize]];
+            let mut r = start;
+            while r + per_test <= end {
+                let group = [stacks[lane][r], stacks[lane][r + per_test - 1]];
+                let rays = [&hot[group[0] as usize], &hot[group[1] as usize]];
                 let (near, hit) = test_boxes::<B>(node, &rays[..per_test]);
                 lengths = lengths + B::select(hit, near, B::splat(0.0));
-                push_hits(&mut stacks, &mut tops, group, hit.bits());
+                push_hits(&mut stacks, &mut tops, &group[..per_test], hit.bits());
+                r += per_test;
             }
-            if let &[id] = groups.remainder() {
+            if r < end {
                 // A lone last ray fills both halves; only its first counts.
+                let id = stacks[lane][r];
                 let ray = &hot[id as usize];
                 let (near, hit) = test_boxes::<B>(node, &[ray, ray][..per_test]);
                 let hit = hit & B::Mask::from_bits(0xF);
