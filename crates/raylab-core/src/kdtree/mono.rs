@@ -116,12 +116,11 @@ impl KdTree {
             return;
         };
         let (origin, inv) = (ray.origin.to_array(), inv.to_array());
-        // Per axis, the offset of the near child from the left one: 1 when the direction is negative on it.
-        let near_offset: [usize; 3] = std::array::from_fn(|k| inv[k].is_sign_negative() as usize);
+        // Bit k is set when the direction is negative on axis k; then the right child is the near one. (Taken
+        // from a register: a per-axis table would put a load on the node-to-node dependency chain.)
+        let neg = inv.iter().enumerate().fold(0usize, |m, (k, v)| m | ((v.is_sign_negative() as usize) << k));
         // Origin and inverse direction side by side, so a node's axis fetches both in one load.
         let line: [[f32; 2]; 3] = std::array::from_fn(|k| [origin[k], inv[k]]);
-        // `t_far` widened by the slack, kept beside it (the product changes only when `t_far` does).
-        let mut far_reach = t_far * (1.0 + SPLIT_SLACK);
         let nodes = self.nodes();
         let mut stack = [Entry::default(); STACK];
         let mut sp = 0usize;
@@ -134,9 +133,9 @@ impl KdTree {
                 let axis = n.axis();
                 let [o, iv] = line[axis];
                 let t_split = (n.split() - o) * iv;
-                let near = n.left() | near_offset[axis];
+                let near = n.left() | ((neg >> axis) & 1);
                 let far = near ^ 1;
-                if t_split > far_reach {
+                if t_split > t_far * (1.0 + SPLIT_SLACK) {
                     node = near;
                 } else if t_split < t_near * (1.0 - SPLIT_SLACK) {
                     node = far;
@@ -147,7 +146,6 @@ impl KdTree {
                     stack[sp] = Entry { node: far as u32, t_near: far_near, t_far };
                     sp += 1;
                     t_far = if t_split < t_far { t_split } else { t_far };
-                    far_reach = t_far * (1.0 + SPLIT_SLACK);
                     node = near;
                 }
                 continue;
@@ -168,7 +166,6 @@ impl KdTree {
                 let e = stack[sp];
                 if e.t_near * (1.0 - SPLIT_SLACK) <= limit {
                     (node, t_near, t_far) = (e.node as usize, e.t_near, e.t_far);
-                    far_reach = t_far * (1.0 + SPLIT_SLACK);
                     break;
                 }
             }
