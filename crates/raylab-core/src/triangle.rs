@@ -154,6 +154,12 @@ impl TriangleSoup {
         &self.verts[i as usize]
     }
 
+    /// The corners of triangles `range`, side by side.
+    #[inline]
+    pub fn slice(&self, range: std::ops::Range<usize>) -> &[[Vec3; 3]] {
+        &self.verts[range]
+    }
+
     /// Number of triangles.
     pub fn len(&self) -> usize {
         self.verts.len()

@@ -167,7 +167,8 @@ fn ray_streams_match_brute_force() {
                 assert_eq!(*b, bf.occluded(&r, &mut TraversalStats::default()), "{name} {label}: {r:?}");
             }
         };
-        // Every backend: eight lanes test two rays per node (a lone last ray of a group included), four one.
+        // Every backend: eight lanes test two rays per node, four one, a task's rays eight or four at a time
+        // (odd and partial last chunks included).
         let cases = Backend::available().into_iter().flat_map(|b| {
             [(16, true), (256, true), (256, false), (4095, true)].into_iter().map(move |(g, o)| (b, g, o))
         });

@@ -97,6 +97,14 @@ pub trait Vf32:
     /// into one vector per field with a register transpose instead of a load per lane and field. `rows` must
     /// hold at least `LANES` rows.
     fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4];
+    /// Each group of four lanes transposed as a 4x4 matrix: lane `4g + j` of result `i` is lane `4g + i` of
+    /// `rows[j]` (the per-ray results of four-wide node tests regrouped per node lane, in MBVH ray streams).
+    fn transpose4(rows: [Self; 4]) -> [Self; 4];
+    /// Left-packs `ids`: writes the entries whose bit is set in `bits` (entry `i` in bit `i`) to the front of
+    /// `out` in order and returns how many there are, with one whole-vector store and no branch per entry
+    /// (MBVH ray streams push a vector of rays onto a lane's stack at once). `out` must hold at least `LANES`
+    /// entries; those past the returned count are left with unspecified values.
+    fn pack_u32(ids: &Self::Array<u32>, bits: u32, out: &mut [u32]) -> usize;
     /// The four fields of `LANES / 4` rows, each row's field in every lane of its group of four (`rows[g]`
     /// in lanes `4g..4g + 4`): several rays' records spread for a test against a four-wide node. `rows` must
     /// hold at least `LANES / 4` rows.
@@ -119,6 +127,24 @@ pub trait Vf32:
             if v > m || m.is_nan() { v } else { m }
         })
     }
+}
+
+/// Asks the CPU to start loading every cache line of `values` (MBVH ray streams fetch a leaf's triangles
+/// while the leaf waits on the task stack). A hint only: it never faults and changes no result; it does
+/// nothing off x86-64.
+#[inline(always)]
+pub fn prefetch<T>(values: &[T]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let start = values.as_ptr().cast::<i8>();
+        for offset in (0..std::mem::size_of_val(values)).step_by(64) {
+            // SAFETY: SSE is part of x86-64; a prefetch reads nothing architecturally and never faults, and
+            // the address lies inside `values`.
+            unsafe { std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(start.add(offset)) }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = values;
 }
 
 /// Which hardware path the kernels use.
@@ -332,6 +358,22 @@ mod tests {
                 );
                 assert!(spread[3].lane(i).is_nan());
                 assert_eq!(quad.lane(i), (i % 4 + 1) as f32);
+            }
+            let groups = V::transpose4(std::array::from_fn(|j| {
+                V::from_slice(&(0..n).map(|i| (100 * j + i) as f32).collect::<Vec<_>>())
+            }));
+            for (c, col) in groups.iter().enumerate() {
+                for i in 0..n {
+                    assert_eq!(col.lane(i), (100 * (i % 4) + i - i % 4 + c) as f32, "transpose4 lane {i} of {c}");
+                }
+            }
+            let ids = V::array_from_fn(|i| 7 + i as u32);
+            for bits in [0u32, 1, 0b1010, 0b0110_1001, u32::MAX, 1 << (n - 1)] {
+                let mut out = [u32::MAX; 16];
+                let kept = V::pack_u32(&ids, bits, &mut out[..n]);
+                let want: Vec<u32> =
+                    ids.as_ref().iter().enumerate().filter(|(i, _)| bits >> i & 1 == 1).map(|(_, &d)| d).collect();
+                assert_eq!(&out[..kept], want.as_slice(), "pack_u32 of {bits:#b}");
             }
             let cols = V::transpose_rows(&refs);
             for i in 0..n {

@@ -144,6 +144,14 @@ impl Vf32 for F32x4 {
         std::array::from_fn(|c| Self(std::array::from_fn(|i| rows[i][c])))
     }
     #[inline(always)]
+    fn transpose4(rows: [Self; 4]) -> [Self; 4] {
+        std::array::from_fn(|c| Self(std::array::from_fn(|i| rows[i].0[c])))
+    }
+    #[inline(always)]
+    fn pack_u32(ids: &[u32; 4], bits: u32, out: &mut [u32]) -> usize {
+        pack4(ids, bits, out)
+    }
+    #[inline(always)]
     fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
         rows[0].map(Self::splat)
     }
@@ -151,4 +159,17 @@ impl Vf32 for F32x4 {
     fn repeat4(quad: &[f32; 4]) -> Self {
         Self(*quad)
     }
+}
+
+/// Left-packs four ids ([`Vf32::pack_u32`]) without vector instructions: each id is written at the next free
+/// place, which advances only when its bit is set.
+#[inline(always)]
+pub(crate) fn pack4(ids: &[u32; 4], bits: u32, out: &mut [u32]) -> usize {
+    let out = &mut out[..4];
+    let mut kept = 0;
+    for (i, &id) in ids.iter().enumerate() {
+        out[kept] = id;
+        kept += (bits >> i & 1) as usize;
+    }
+    kept
 }

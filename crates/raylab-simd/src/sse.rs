@@ -155,8 +155,12 @@ impl Vf32 for F32x4 {
     #[inline(always)]
     fn transpose_rows(rows: &[&[f32; 4]]) -> [Self; 4] {
         // SAFETY: each row is a reference to four readable `f32`s and `loadu` has no alignment requirement.
-        let load = |i: usize| unsafe { _mm_loadu_ps(rows[i].as_ptr()) };
-        let (a, b, c, d) = (load(0), load(1), load(2), load(3));
+        let load = |i: usize| Self(unsafe { _mm_loadu_ps(rows[i].as_ptr()) });
+        Self::transpose4([load(0), load(1), load(2), load(3)])
+    }
+    #[inline(always)]
+    fn transpose4(rows: [Self; 4]) -> [Self; 4] {
+        let [a, b, c, d] = rows.map(|r| r.0);
         sse!({
             let (ab_lo, cd_lo) = (_mm_unpacklo_ps(a, b), _mm_unpacklo_ps(c, d));
             let (ab_hi, cd_hi) = (_mm_unpackhi_ps(a, b), _mm_unpackhi_ps(c, d));
@@ -167,6 +171,11 @@ impl Vf32 for F32x4 {
                 Self(_mm_movehl_ps(cd_hi, ab_hi)),
             ]
         })
+    }
+    #[inline(always)]
+    fn pack_u32(ids: &[u32; 4], bits: u32, out: &mut [u32]) -> usize {
+        // SSE2 has no variable lane shuffle; four scalar writes do it.
+        crate::scalar::pack4(ids, bits, out)
     }
     #[inline(always)]
     fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4] {

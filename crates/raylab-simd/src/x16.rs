@@ -202,6 +202,11 @@ impl Vf32 for F32x16 {
         let b = load_blocks([rows[1], rows[5], rows[9], rows[13]]);
         let c = load_blocks([rows[2], rows[6], rows[10], rows[14]]);
         let d = load_blocks([rows[3], rows[7], rows[11], rows[15]]);
+        Self::transpose4([a, b, c, d].map(Self))
+    }
+    #[inline(always)]
+    fn transpose4(rows: [Self; 4]) -> [Self; 4] {
+        let [a, b, c, d] = rows.map(|r| r.0);
         avx512!({
             let (ab_lo, cd_lo) = (_mm512_unpacklo_ps(a, b), _mm512_unpacklo_ps(c, d));
             let (ab_hi, cd_hi) = (_mm512_unpackhi_ps(a, b), _mm512_unpackhi_ps(c, d));
@@ -212,6 +217,18 @@ impl Vf32 for F32x16 {
                 Self(_mm512_shuffle_ps::<0xee>(ab_hi, cd_hi)),
             ]
         })
+    }
+    #[inline(always)]
+    fn pack_u32(ids: &[u32; 16], bits: u32, out: &mut [u32]) -> usize {
+        assert!(out.len() >= 16);
+        let keep = bits as u16;
+        // SAFETY: `ids` is sixteen readable `u32`s and the assert guarantees sixteen writable ones in `out`;
+        // `loadu`/`storeu` have no alignment requirement; AVX-512F is present (see `avx512!`).
+        unsafe {
+            let v = _mm512_loadu_si512(ids.as_ptr().cast());
+            _mm512_storeu_si512(out.as_mut_ptr().cast(), _mm512_maskz_compress_epi32(keep, v));
+        }
+        keep.count_ones() as usize
     }
     #[inline(always)]
     fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4] {

@@ -23,6 +23,25 @@ macro_rules! avx {
     };
 }
 
+/// Per 8-bit mask, the lanes whose bits are set, in order, one byte each (zero after them): the lane order
+/// that left-packs eight lanes ([`Vf32::pack_u32`]), 2 KiB.
+static PACK8: [u64; 256] = {
+    let mut table = [0u64; 256];
+    let mut mask = 0;
+    while mask < 256 {
+        let (mut lane, mut kept) = (0, 0);
+        while lane < 8 {
+            if mask >> lane & 1 == 1 {
+                table[mask] |= (lane as u64) << (8 * kept);
+                kept += 1;
+            }
+            lane += 1;
+        }
+        mask += 1;
+    }
+    table
+};
+
 /// Eight `f32` lanes.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct F32x8(__m256);
@@ -180,9 +199,13 @@ impl Vf32 for F32x8 {
         let pair = |i: usize| {
             // SAFETY: each row is a reference to four readable `f32`s and `loadu` has no alignment
             // requirement; AVX is present (see `avx!`).
-            unsafe { _mm256_loadu2_m128(rows[i + 4].as_ptr(), rows[i].as_ptr()) }
+            Self(unsafe { _mm256_loadu2_m128(rows[i + 4].as_ptr(), rows[i].as_ptr()) })
         };
-        let (a, b, c, d) = (pair(0), pair(1), pair(2), pair(3));
+        Self::transpose4([pair(0), pair(1), pair(2), pair(3)])
+    }
+    #[inline(always)]
+    fn transpose4(rows: [Self; 4]) -> [Self; 4] {
+        let [a, b, c, d] = rows.map(|r| r.0);
         avx!({
             let (ab_lo, cd_lo) = (_mm256_unpacklo_ps(a, b), _mm256_unpacklo_ps(c, d));
             let (ab_hi, cd_hi) = (_mm256_unpackhi_ps(a, b), _mm256_unpackhi_ps(c, d));
@@ -193,6 +216,19 @@ impl Vf32 for F32x8 {
                 Self(_mm256_shuffle_ps::<0xee>(ab_hi, cd_hi)),
             ]
         })
+    }
+    #[inline(always)]
+    fn pack_u32(ids: &[u32; 8], bits: u32, out: &mut [u32]) -> usize {
+        assert!(out.len() >= 8);
+        let keep = (bits & 0xff) as usize;
+        // SAFETY: `ids` is eight readable `u32`s and the assert guarantees eight writable ones in `out`;
+        // `loadu`/`storeu` have no alignment requirement; AVX2 is present (see `avx!`).
+        unsafe {
+            let v = _mm256_loadu_si256(ids.as_ptr().cast());
+            let order = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(PACK8[keep] as i64));
+            _mm256_storeu_si256(out.as_mut_ptr().cast(), _mm256_permutevar8x32_epi32(v, order));
+        }
+        keep.count_ones() as usize
     }
     #[inline(always)]
     fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4] {

@@ -115,6 +115,12 @@ impl Mbvh {
         tri4::closest_in_leaf(shear, &self.blocks, &self.tri_ids, slots, tmin, best_t, best);
     }
 
+    /// Starts loading the four-triangle blocks of a leaf's `slots` into the cache.
+    #[inline(always)]
+    pub(super) fn prefetch_leaf(&self, slots: Range<usize>) {
+        raylab_simd::prefetch(&self.blocks[slots.start / 4..slots.end.div_ceil(4)]);
+    }
+
     /// [`tri4::blocker_in_leaf`] on this tree's blocks.
     #[inline(always)]
     pub(super) fn blocker_in_leaf<V: Vf32>(

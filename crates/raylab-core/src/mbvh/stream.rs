@@ -12,7 +12,11 @@
 //! What the box tests read of each ray (origin, inverse direction, `tmin`, current limit) lives in a 32-byte
 //! record apart from the rest, so a 2^12-ray group's box data stays in the L2 cache. With eight SIMD lanes
 //! (AVX2) two rays are tested against a node's four boxes at once, each in its own half; leaves still pack
-//! rays four at a time.
+//! rays four at a time. A task's rays go a vector's worth at a time (eight or four): their hit flags are
+//! regrouped per child by a 4x4 transpose, and each child's hitting rays are left-packed onto its stack with
+//! one vector store ([`Vf32::pack_u32`]) rather than one store and one branch-free add per ray and child.
+//! When a leaf child gets rays, its triangles are prefetched, in the form its tests will read, while the
+//! siblings before it on the task stack are walked.
 
 use std::ops::Range;
 
@@ -29,6 +33,12 @@ use crate::triangle::RayShear;
 
 /// Rays left over after whole packets of four, up to this many, are tested alone against the leaf.
 const ALONE_MAX: usize = 2;
+
+/// How many of a leaf's `rays` are tested alone: the rays left after whole packets of four, when there are at
+/// most [`ALONE_MAX`] of them.
+fn alone_of(rays: usize) -> usize {
+    if rays % 4 <= ALONE_MAX { rays % 4 } else { 0 }
+}
 
 /// A pending task: `count` rays on top of lane `lane`'s stack reached child `child` (a node, or a leaf when
 /// `tris > 0`).
@@ -77,8 +87,12 @@ impl Hot {
 /// put in entry order by the direction's signs with selects instead of branches, as rays in a group differ.
 #[inline(always)]
 fn test_boxes<B: Vf32>(node: &MbvhNode, rays: &[&Hot]) -> (B, B::Mask) {
-    let [ox, oy, oz, tmin] = B::splat_rows(&[&rays[0].rows[0], &rays[rays.len() - 1].rows[0]]);
-    let [ix, iy, iz, best] = B::splat_rows(&[&rays[0].rows[1], &rays[rays.len() - 1].rows[1]]);
+    let (mut first, mut second) = ([&rays[0].rows[0]; 4], [&rays[0].rows[1]; 4]);
+    for (g, ray) in rays.iter().enumerate() {
+        (first[g], second[g]) = (&ray.rows[0], &ray.rows[1]);
+    }
+    let [ox, oy, oz, tmin] = B::splat_rows(&first[..rays.len()]);
+    let [ix, iy, iz, best] = B::splat_rows(&second[..rays.len()]);
     let (org, inv) = ([ox, oy, oz], [ix, iy, iz]);
     let zero = B::splat(0.0);
     let (mut near, mut far) = (tmin, best);
@@ -92,19 +106,6 @@ fn test_boxes<B: Vf32>(node: &MbvhNode, rays: &[&Hot]) -> (B, B::Mask) {
         far = B::select(neg, lo, hi).min(far);
     }
     (near, near.le(far * B::splat(FAR_SLACK)))
-}
-
-/// Writes each ray of `group` onto all four lane stacks at their tops and keeps it (advances the top) where
-/// its bit in `bits` is set (ray `j`'s bits are `4j..4j + 4`, lane by lane): a write without a branch on
-/// whether the ray hit the lane's box.
-#[inline(always)]
-fn push_hits(stacks: &mut [&mut [u32]; 4], tops: &mut [usize; 4], group: &[u32], bits: u32) {
-    for (j, &id) in group.iter().enumerate() {
-        for (k, stack) in stacks.iter_mut().enumerate() {
-            stack[tops[k]] = id;
-            tops[k] += (bits >> (4 * j + k) & 1) as usize;
-        }
-    }
 }
 
 /// Moves the ids of the rays in `ids` not yet blocked to its front, in order; returns how many there are.
@@ -238,7 +239,7 @@ impl Mbvh {
                 // Whole packets go through the paper's four-rays-per-triangle tests; a remainder of one or
                 // two rays would leave most lanes idle, so each such ray takes the leaf's triangles four at a
                 // time instead, as a single ray does.
-                let alone = if current.len() % 4 <= ALONE_MAX { current.len() % 4 } else { 0 };
+                let alone = alone_of(current.len());
                 let (packed, single) = current.split_at(current.len() - alone);
                 for group in packed.chunks(4) {
                     tests += self.leaf_packet::<V>(hot, slots, group, tri_slots.clone(), shadow);
@@ -251,41 +252,73 @@ impl Mbvh {
             }
             fetches += 1;
             let node = &self.nodes[task.child as usize];
+            let n = end - start;
             for (k, stack) in lanes.iter_mut().enumerate() {
-                if stack.len() < top[k] + (end - start) {
-                    stack.resize(top[k] + (end - start), 0);
+                // Room for every ray of the task and one vector more: rays are read and pushed a vector at a
+                // time (the own lane's `top` is `start`, so its room also covers the task's last read).
+                if stack.len() < top[k] + n + B::LANES {
+                    stack.resize(top[k] + n + B::LANES, 0);
                 }
             }
-            box_tests += (end - start) as u64;
-            // The task's rays are read from their lane's stack a test's worth at a time (two rays with eight
-            // lanes) while each is pushed onto the stack of every lane whose box it hits, in place: a lane's
-            // top never passes the next ray to read, since each ray pushes at most one entry per lane. The
-            // tops live in a local copy, indexed only by constants, so they stay in registers.
+            box_tests += n as u64;
+            // The task's rays are taken `B::LANES` at a time: up to four box tests of `per_test` consecutive
+            // rays each, whose hit flags a 4x4 transpose regroups per child lane, so that each lane's hitting
+            // rays are left-packed onto its stack by one vector store. That happens in place: a lane's top
+            // never passes the next ray to read, since each ray pushes at most one entry per lane, and the
+            // vector's rays were copied out before any store.
             let [l0, l1, l2, l3] = &mut lanes;
             let mut stacks = [&mut l0[..], &mut l1[..], &mut l2[..], &mut l3[..]];
             let mut tops = top;
-            let mut lengths = B::splat(0.0);
+            let (zero, flag) = (B::splat(0.0), B::splat(-1.0));
+            let mut lengths = zero;
             let per_test = B::LANES / 4;
             let mut r = start;
-            while r + per_test <= end {
-                let group = [stacks[lane][r], stacks[lane][r + per_test - 1]];
-                let rays = [&hot[group[0] as usize], &hot[group[1] as usize]];
-                let (near, hit) = test_boxes::<B>(node, &rays[..per_test]);
-                lengths = lengths + B::select(hit, near, B::splat(0.0));
-                push_hits(&mut stacks, &mut tops, &group[..per_test], hit.bits());
-                r += per_test;
-            }
-            if r < end {
-                // A lone last ray fills both halves; only its first counts.
-                let id = stacks[lane][r];
-                let ray = &hot[id as usize];
-                let (near, hit) = test_boxes::<B>(node, &[ray, ray][..per_test]);
-                let hit = hit & B::Mask::from_bits(0xF);
-                lengths = lengths + B::select(hit, near, B::splat(0.0));
-                push_hits(&mut stacks, &mut tops, &[id], hit.bits());
+            while r < end {
+                let rem = (end - r).min(B::LANES);
+                let ids = &stacks[lane][r..r + B::LANES];
+                // After the transpose, lane `4g + p` of a child's flags is ray `per_test * p + g`'s: the ids in
+                // that order, for the packing. (Loops rather than `array::from_fn`, whose closures would be
+                // compiled outside the SIMD entry point.)
+                let mut order = B::array_from_fn(|_| 0);
+                for (i, slot) in order.as_mut().iter_mut().enumerate() {
+                    *slot = ids[per_test * (i % 4) + i / 4];
+                }
+                let mut flags = [zero; 4];
+                for (p, flags) in flags.iter_mut().enumerate().take(rem.div_ceil(per_test)) {
+                    let a = per_test * p;
+                    // Past the chunk's last ray, groups repeat it, and their hits are masked off.
+                    let mut rays = [&hot[ids[a] as usize]; 4];
+                    for (g, ray) in rays.iter_mut().enumerate().take(per_test).skip(1) {
+                        *ray = &hot[ids[(a + g).min(rem - 1)] as usize];
+                    }
+                    let (near, mut hit) = test_boxes::<B>(node, &rays[..per_test]);
+                    if a + per_test > rem {
+                        hit = hit & B::Mask::from_bits((1 << (4 * (rem - a))) - 1);
+                    }
+                    lengths = lengths + B::select(hit, near, zero);
+                    *flags = B::select(hit, flag, zero);
+                }
+                for ((stack, top), hits) in stacks.iter_mut().zip(&mut tops).zip(B::transpose4(flags)) {
+                    *top += B::pack_u32(&order, hits.lt(zero).bits(), &mut stack[*top..]);
+                }
+                r += B::LANES;
             }
             let pushed: [usize; 4] = std::array::from_fn(|k| tops[k] - top[k]);
             top = tops;
+            for (k, &rays) in pushed.iter().enumerate() {
+                if rays > 0 && node.is_leaf(k) {
+                    // The leaf's triangles in the form its tests will read: corners for packets, blocks for
+                    // rays alone.
+                    let slots = node.child[k] as usize..(node.child[k] + node.count[k]) as usize;
+                    let alone = alone_of(rays);
+                    if rays > alone {
+                        raylab_simd::prefetch(self.tris.slice(slots.clone()));
+                    }
+                    if alone > 0 {
+                        self.prefetch_leaf(slots);
+                    }
+                }
+            }
             let mut sums = [0f32; 8];
             lengths.write_to(&mut sums[..B::LANES]);
             let lengths_out: [f32; 4] = std::array::from_fn(|k| sums[k] + sums[k + 4]);
@@ -396,7 +429,9 @@ impl Mbvh {
 }
 
 /// A group traced with the backend's lane type ([`raylab_simd::dispatch`]): eight lanes test two rays per node
-/// and leave the leaves to SSE's four, four lanes do both.
+/// and leave the leaves to SSE's four, four lanes do both. Sixteen (four rays per node test, each chunk's
+/// pushes by AVX-512 compress) measured slower (4.24 against 4.65 Mrays/s at 2^12, 2.87 against 3.34 at 2^8,
+/// Sponza's diffuse rays), so streams run as under AVX2 there ([`raylab_simd::Backend::at_most_eight_lanes`]).
 struct Stream<'a, F> {
     mbvh: &'a Mbvh,
     rays: &'a [Option<Ray>],
