@@ -14,6 +14,8 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 # shellcheck source=lib/splice.sh
 source "$root/scripts/lib/splice.sh"
+# shellcheck source=lib/cpu.sh
+source "$root/scripts/lib/cpu.sh"
 frames=${FRAMES:-40}
 section=${SECTION:-hybrid}
 [ -n "${SKIP_BUILD:-}" ] || cargo build --release -p raylab-viewer --manifest-path "$root/Cargo.toml"
@@ -24,7 +26,7 @@ table="$work/table.md"
 commit=${COMMIT:-$(git describe --always --dirty --abbrev=12)}
 toolchain=$(rustc --version 2>/dev/null || echo "binary built elsewhere")
 gpus="$work/gpus"
-cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
+cpu=$(cpu_name)
 sponza=(--scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0)
 {
   echo "Machine and build: commit $commit, $toolchain, CPU $cpu ($(nproc) logical CPUs), GPU GPU_NAMES."

@@ -10,6 +10,8 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 # shellcheck source=lib/splice.sh
 source "$root/scripts/lib/splice.sh"
+# shellcheck source=lib/cpu.sh
+source "$root/scripts/lib/cpu.sh"
 frames=${FRAMES:-60}
 cargo build --release -p raylab-viewer --manifest-path "$root/Cargo.toml"
 cd "$root"
@@ -21,7 +23,7 @@ sponza=(--scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 --target 10
 work=$(mktemp -d)
 table="$work/table.md"
 commit=$(git describe --always --dirty --abbrev=12)
-cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
+cpu=$(cpu_name)
 {
   echo "Machine and build: commit $commit, $(rustc --version), CPU $cpu ($(nproc) logical CPUs)."
   echo "Command: \`scripts/viewer-fps.sh\` (FRAMES=$frames): for each row, \`${run[*]} target/release/raylab ${sponza[*]} --width W --height H --method M --tile T --shadows hard --frames $frames --json-stats FILE\`; the panel is shown."

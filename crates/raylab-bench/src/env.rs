@@ -9,7 +9,8 @@ pub struct Environment {
     pub commit: String,
     /// The compiler that built this binary.
     pub rustc: &'static str,
-    /// CPU model name.
+    /// CPU model name, with the family and model numbers where the kernel reports them (virtual machines often
+    /// name every generation alike, "AMD EPYC", and the numbers tell them apart).
     pub cpu: String,
     /// Logical CPUs.
     pub cpus: usize,
@@ -30,8 +31,7 @@ impl Environment {
             .unwrap_or_else(|| "unknown".into());
         let cpu = std::fs::read_to_string("/proc/cpuinfo")
             .ok()
-            .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.to_string()))
-            .and_then(|l| l.split(':').nth(1).map(|s| s.trim().to_string()))
+            .and_then(|info| cpu_name(&info))
             .unwrap_or_else(|| std::env::consts::ARCH.into());
         Self {
             commit,
@@ -55,6 +55,22 @@ impl Environment {
     }
 }
 
+/// The first processor's model name from `/proc/cpuinfo` text, followed by its family and model numbers when
+/// both are there.
+fn cpu_name(info: &str) -> Option<String> {
+    let field = |key: &str| {
+        info.lines()
+            .find(|l| l.split(':').next().is_some_and(|k| k.trim() == key))
+            .and_then(|l| l.split_once(':'))
+            .map(|(_, v)| v.trim().to_string())
+    };
+    let name = field("model name")?;
+    Some(match (field("cpu family"), field("model")) {
+        (Some(family), Some(model)) => format!("{name}, family {family} model {model}"),
+        _ => name,
+    })
+}
+
 #[cfg(target_arch = "x86_64")]
 fn simd_features() -> Vec<&'static str> {
     let mut v = Vec::new();
@@ -76,4 +92,18 @@ fn simd_features() -> Vec<&'static str> {
 #[cfg(not(target_arch = "x86_64"))]
 fn simd_features() -> Vec<&'static str> {
     Vec::new()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cpu_name;
+
+    #[test]
+    fn cpu_name_carries_family_and_model_when_known() {
+        let info =
+            "processor\t: 0\nvendor_id\t: AuthenticAMD\ncpu family\t: 26\nmodel\t\t: 2\nmodel name\t: AMD EPYC\n";
+        assert_eq!(cpu_name(info).as_deref(), Some("AMD EPYC, family 26 model 2"));
+        assert_eq!(cpu_name("model name\t: Some CPU\n").as_deref(), Some("Some CPU"));
+        assert_eq!(cpu_name("flags\t: sse2\n"), None);
+    }
 }
