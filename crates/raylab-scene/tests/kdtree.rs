@@ -96,6 +96,11 @@ fn stats_are_consistent_and_build_is_deterministic() {
     assert!(s.max_depth <= params.depth_for(scene.triangle_count()));
     assert!(s.tri_refs >= scene.triangle_count(), "every triangle is in at least one leaf");
     assert_eq!(std::mem::size_of::<raylab_core::kdtree::KdNode>(), 8);
+    // The leaf-order copy of the corners holds each reference's triangle.
+    assert_eq!(a.ref_triangles().len(), a.tri_ids().len());
+    for (r, &id) in a.tri_ids().iter().enumerate() {
+        assert_eq!(a.ref_triangles().get(r as u32), a.triangles().get(id), "reference {r}");
+    }
     // Children are adjacent and even-aligned.
     for n in a.nodes() {
         if !n.is_leaf() {

@@ -52,12 +52,17 @@ impl std::fmt::Display for KdBuildError {
 impl std::error::Error for KdBuildError {}
 
 /// A kd-tree over a scene's triangles, in the traversal layout: 8-byte nodes with adjacent children, leaves
-/// indexing a contiguous triangle-id array, and a copy of the triangle corners for the intersection kernel.
+/// indexing a contiguous triangle-id array, and two copies of the triangle corners for the intersection
+/// kernels: by triangle id, and by reference in leaf order.
 #[derive(Clone, Debug)]
 pub struct KdTree {
     nodes: Vec<KdNode>,
     tri_ids: Vec<u32>,
     tris: TriangleSoup,
+    /// The corners of each reference's triangle, side by side in leaf order (`ref_tris.get(r)` is triangle
+    /// `tri_ids[r]`): single rays test a leaf without first loading its ids, and the leaf's corners share
+    /// cache lines (Sponza: 327,571 references, 11.8 MB).
+    ref_tris: TriangleSoup,
     bounds: Aabb,
     leaf_bounds: LeafBounds,
     params: KdParams,
@@ -102,6 +107,7 @@ impl KdTree {
         let leaf_bounds = LeafBounds::default();
         let mut tree = Self {
             nodes,
+            ref_tris: TriangleSoup::gather(scene, &out.tri_ids),
             tri_ids: out.tri_ids,
             tris,
             bounds,
@@ -136,6 +142,12 @@ impl KdTree {
     /// The triangle corners the kernels test.
     pub fn triangles(&self) -> &TriangleSoup {
         &self.tris
+    }
+
+    /// The corners of the triangle each reference names, in leaf order: reference `r` is triangle
+    /// `tri_ids()[r]`.
+    pub fn ref_triangles(&self) -> &TriangleSoup {
+        &self.ref_tris
     }
 
     /// The (slightly padded) box of the root node; empty for an empty scene.

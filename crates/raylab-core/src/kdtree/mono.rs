@@ -49,9 +49,10 @@ impl KdTree {
         let mut reach = hit_reach(best_t);
         let mut tests = 0u64;
         self.traverse(ray, stats, |ids, _, _| {
-            for &id in &self.tri_ids()[ids] {
+            for slot in ids {
                 tests += 1;
-                if let Some(h) = shear.intersect(self.triangles().get(id), ray.tmin, best_t) {
+                if let Some(h) = shear.intersect(self.ref_triangles().get(slot as u32), ray.tmin, best_t) {
+                    let id = self.tri_ids()[slot];
                     let h = Hit { t: h.t, tri: id, u: h.u, v: h.v };
                     if h.beats(best) {
                         best_t = h.t;
@@ -78,10 +79,10 @@ impl KdTree {
         let mut blocker = None;
         let mut tests = 0u64;
         self.traverse(ray, stats, |ids, _, _| {
-            for &id in &self.tri_ids()[ids] {
+            for slot in ids {
                 tests += 1;
-                if shear.intersect(self.triangles().get(id), ray.tmin, ray.tmax).is_some() {
-                    blocker = Some(id);
+                if shear.intersect(self.ref_triangles().get(slot as u32), ray.tmin, ray.tmax).is_some() {
+                    blocker = Some(self.tri_ids()[slot]);
                     return Next::Stop;
                 }
             }
