@@ -114,19 +114,23 @@ impl Aabb {
     /// An axis with an infinite inverse direction (a zero direction component) constrains nothing when the
     /// origin lies within that slab, boundary included, and misses otherwise; this avoids the NaN of `0 * inf`.
     pub fn clip_ray(&self, origin: Vec3, inv_dir: Vec3, tmin: f32, tmax: f32) -> Option<(f32, f32)> {
+        let (lo, hi, o, inv) = (self.min.to_array(), self.max.to_array(), origin.to_array(), inv_dir.to_array());
         let mut t0 = tmin;
         let mut t1 = tmax;
+        // Straight-line code per axis (selects, no early return), so the three axes overlap: an axis that
+        // misses empties the interval instead of returning. Nothing here is NaN for a valid ray (finite
+        // origin, a finite inverse where it is used, non-NaN `tmin` and `tmax`), so plain comparisons give
+        // `f32::min`/`max`'s values with one instruction each.
         for k in 0..3 {
-            if inv_dir[k].is_infinite() {
-                if origin[k] < self.min[k] || origin[k] > self.max[k] {
-                    return None;
-                }
-                continue;
-            }
-            let ta = (self.min[k] - origin[k]) * inv_dir[k];
-            let tb = (self.max[k] - origin[k]) * inv_dir[k];
-            t0 = t0.max(ta.min(tb));
-            t1 = t1.min(ta.max(tb));
+            let (enter, exit) = if inv[k].is_infinite() {
+                if o[k] < lo[k] || o[k] > hi[k] { (f32::INFINITY, f32::NEG_INFINITY) } else { (t0, t1) }
+            } else {
+                let ta = (lo[k] - o[k]) * inv[k];
+                let tb = (hi[k] - o[k]) * inv[k];
+                if ta < tb { (ta, tb) } else { (tb, ta) }
+            };
+            t0 = if enter > t0 { enter } else { t0 };
+            t1 = if exit < t1 { exit } else { t1 };
         }
         (t0 <= t1).then_some((t0, t1))
     }
@@ -145,6 +149,48 @@ mod tests {
         assert_eq!(a, b);
         assert!(Aabb::EMPTY.is_empty());
         assert_eq!(a.longest_axis(), 2);
+    }
+
+    /// The slab test written plainly: an early miss for an axis-parallel ray outside its slab, `f32::min`
+    /// and `max` for the others.
+    fn clip_reference(b: &Aabb, o: Vec3, inv: Vec3, tmin: f32, tmax: f32) -> Option<(f32, f32)> {
+        let (mut t0, mut t1) = (tmin, tmax);
+        for k in 0..3 {
+            if inv[k].is_infinite() {
+                if o[k] < b.min[k] || o[k] > b.max[k] {
+                    return None;
+                }
+                continue;
+            }
+            let (ta, tb) = ((b.min[k] - o[k]) * inv[k], (b.max[k] - o[k]) * inv[k]);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+        (t0 <= t1).then_some((t0, t1))
+    }
+
+    #[test]
+    fn clip_ray_matches_the_plain_slab_test() {
+        let b = Aabb::new(Vec3::new(-1.0, -2.0, 0.5), Vec3::new(3.0, 1.0, 4.0));
+        let mut state = 0x2545_f491_u32;
+        let mut next = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1 << 24) as f32 * 10.0 - 5.0
+        };
+        for i in 0..20_000 {
+            let o = Vec3::new(next(), next(), next());
+            let mut d = Vec3::new(next(), next(), next());
+            // Zero components of both signs, and whole axis-parallel rays.
+            if i % 5 == 0 {
+                d[i % 3] = if i % 2 == 0 { 0.0 } else { -0.0 };
+            }
+            if i % 17 == 0 {
+                d = Vec3::new(0.0, 0.0, 1.0);
+            }
+            let (tmin, tmax) = if i % 7 == 0 { (next().abs(), next().abs()) } else { (0.0, f32::INFINITY) };
+            let inv = Vec3::ONE / d;
+            assert_eq!(b.clip_ray(o, inv, tmin, tmax), clip_reference(&b, o, inv, tmin, tmax), "{o} {d} {tmin} {tmax}");
+        }
     }
 
     #[test]
