@@ -14,7 +14,7 @@ use crate::ray::{Hit, Ray, hit_reach};
 use crate::stats::TraversalStats;
 use crate::triangle::RayShear;
 
-use super::{KdParams, KdTree};
+use super::{KdNode, KdParams, KdTree};
 
 /// What a leaf visitor tells the traversal.
 pub(super) enum Next {
@@ -119,7 +119,8 @@ impl KdTree {
         let (origin, inv) = (ray.origin.to_array(), inv.to_array());
         // Bit k is set when the direction is negative on axis k; then the right child is the near one. (Taken
         // from a register: a per-axis table would put a load on the node-to-node dependency chain.)
-        let neg = inv.iter().enumerate().fold(0usize, |m, (k, v)| m | ((v.is_sign_negative() as usize) << k));
+        let neg = inv.iter().enumerate().fold(0u32, |m, (k, v)| m | ((v.is_sign_negative() as u32) << k));
+        let signs = KdNode::sign_pattern(neg);
         // Origin and inverse direction side by side, so a node's axis fetches both in one load.
         let line: [[f32; 2]; 3] = std::array::from_fn(|k| [origin[k], inv[k]]);
         let nodes = self.nodes();
@@ -134,7 +135,7 @@ impl KdTree {
                 let axis = n.axis();
                 let [o, iv] = line[axis];
                 let t_split = (n.split() - o) * iv;
-                let near = n.left() | ((neg >> axis) & 1);
+                let near = n.near_child(signs);
                 let far = near ^ 1;
                 if t_split > t_far * (1.0 + SPLIT_SLACK) {
                     node = near;

@@ -57,6 +57,22 @@ impl KdNode {
         (self.word >> 2) as usize
     }
 
+    /// The child of an inner node a ray meets first: the left one, or the right one where the ray's direction
+    /// is negative on the split axis. `signs` holds that per axis as [`KdNode::sign_pattern`] spreads it: the
+    /// word's low five bits select its bit directly (a shift by the whole word, which the hardware takes
+    /// modulo 32), so finding the child waits for no masking of the axis after the node's load.
+    #[inline(always)]
+    pub fn near_child(self, signs: u32) -> usize {
+        (self.word >> 2) as usize | (signs.wrapping_shr(self.word) & 1) as usize
+    }
+
+    /// Per-axis flags (bit `k` of `negative` set when the direction is negative on axis `k`) repeated every
+    /// four bits, the form [`KdNode::near_child`] takes: bit `i` is flag `i % 4` (`i % 4 == 3`, a leaf's
+    /// code, is never read).
+    pub fn sign_pattern(negative: u32) -> u32 {
+        (negative & 7) * 0x1111_1111
+    }
+
     /// The range of `KdTree::tri_ids` a leaf covers.
     #[inline(always)]
     pub fn leaf_range(self) -> std::ops::Range<usize> {
@@ -74,6 +90,12 @@ mod tests {
         let n = KdNode::inner(2, -1.5, 12345);
         assert!(!n.is_leaf());
         assert_eq!((n.axis(), n.split(), n.left()), (2, -1.5, 12345));
+        let signs = KdNode::sign_pattern(0b101);
+        for (axis, want) in [(0, 1), (1, 0), (2, 1)] {
+            for left in [0, 2, 12344, MAX_INDEX as u32 - 1] {
+                assert_eq!(KdNode::inner(axis, 0.5, left).near_child(signs), left as usize + want, "{axis} {left}");
+            }
+        }
         let l = KdNode::leaf(MAX_INDEX as u32, 7);
         assert!(l.is_leaf());
         assert_eq!(l.leaf_range(), MAX_INDEX..MAX_INDEX + 7);
