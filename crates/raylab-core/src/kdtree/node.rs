@@ -60,10 +60,11 @@ impl KdNode {
     /// The child of an inner node a ray meets first: the left one, or the right one where the ray's direction
     /// is negative on the split axis. `signs` holds that per axis as [`KdNode::sign_pattern`] spreads it: the
     /// word's low five bits select its bit directly (a shift by the whole word, which the hardware takes
-    /// modulo 32), so finding the child waits for no masking of the axis after the node's load.
+    /// modulo 32), and the bit is added rather than or-ed in (the sibling follows the even-aligned left
+    /// child), so finding the child is a bit test and an add-with-carry after the node's load.
     #[inline(always)]
     pub fn near_child(self, signs: u32) -> usize {
-        (self.word >> 2) as usize | (signs.wrapping_shr(self.word) & 1) as usize
+        ((self.word >> 2) + (signs.wrapping_shr(self.word) & 1)) as usize
     }
 
     /// Per-axis flags (bit `k` of `negative` set when the direction is negative on axis `k`) repeated every
