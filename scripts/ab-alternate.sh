@@ -16,17 +16,12 @@ if [ $# -lt 4 ]; then
 fi
 old=$1 new=$2 rounds=$3
 shift 3
-case $rounds in '' | *[!0-9]*) echo "ROUNDS must be a positive integer, got '$rounds'" >&2; exit 2 ;; esac
-for b in "$old" "$new"; do
-  [ -x "$b" ] || { echo "not an executable: $b" >&2; exit 2; }
-done
-median() { awk '/Mrays\/s/ { print $3; found = 1 } END { if (!found) exit 1 }'; }
-sum=0
+# shellcheck source=lib/ab.sh
+source "$(dirname "$0")/lib/ab.sh"
+ab_check_args "$old" "$new" "$rounds"
 for i in $(seq 1 "$rounds"); do
-  a=$(taskset -c 0 "$old" "$@" 2>&1 | median) || { echo "round $i: the old binary printed no Mrays/s line" >&2; exit 1; }
-  b=$(taskset -c 0 "$new" "$@" 2>&1 | median) || { echo "round $i: the new binary printed no Mrays/s line" >&2; exit 1; }
-  ratio=$(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.3f", b / a }')
-  sum=$(awk -v s="$sum" -v r="$ratio" 'BEGIN { print s + r }')
-  echo "round $i: old $a, new $b Mrays/s, new/old $ratio"
+  a=$(taskset -c 0 "$old" "$@" 2>&1 | ab_median) || { echo "round $i: the old binary printed no Mrays/s line" >&2; exit 1; }
+  b=$(taskset -c 0 "$new" "$@" 2>&1 | ab_median) || { echo "round $i: the new binary printed no Mrays/s line" >&2; exit 1; }
+  ab_report "$i" "$a" "$b"
 done
-awk -v s="$sum" -v n="$rounds" 'BEGIN { printf "mean new/old %.3f over %d rounds\n", s / n, n }'
+ab_summary "$rounds"

@@ -14,15 +14,12 @@ if [ $# -lt 4 ]; then
 fi
 old=$1 new=$2 rounds=$3
 shift 3
-case $rounds in '' | *[!0-9]*) echo "ROUNDS must be a positive integer, got '$rounds'" >&2; exit 2 ;; esac
-for b in "$old" "$new"; do
-  [ -x "$b" ] || { echo "not an executable: $b" >&2; exit 2; }
-done
+# shellcheck source=lib/ab.sh
+source "$(dirname "$0")/lib/ab.sh"
+ab_check_args "$old" "$new" "$rounds"
 [ "$(nproc)" -ge 2 ] || { echo "needs at least two CPUs" >&2; exit 2; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-median() { awk '/Mrays\/s/ { print $3; found = 1 } END { if (!found) exit 1 }' "$1"; }
-sum=0
 for i in $(seq 1 "$rounds"); do
   if [ $((i % 2)) -eq 1 ]; then c_old=0 c_new=1; else c_old=1 c_new=0; fi
   taskset -c "$c_old" "$old" "$@" > "$work/old" 2>&1 &
@@ -31,10 +28,8 @@ for i in $(seq 1 "$rounds"); do
   p_new=$!
   wait "$p_old" || { echo "old binary failed:" >&2; cat "$work/old" >&2; exit 1; }
   wait "$p_new" || { echo "new binary failed:" >&2; cat "$work/new" >&2; exit 1; }
-  a=$(median "$work/old") || { echo "no Mrays/s line from the old binary" >&2; exit 1; }
-  b=$(median "$work/new") || { echo "no Mrays/s line from the new binary" >&2; exit 1; }
-  ratio=$(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.3f", b / a }')
-  sum=$(awk -v s="$sum" -v r="$ratio" 'BEGIN { print s + r }')
-  echo "round $i: old $a, new $b Mrays/s, new/old $ratio"
+  a=$(ab_median < "$work/old") || { echo "no Mrays/s line from the old binary" >&2; exit 1; }
+  b=$(ab_median < "$work/new") || { echo "no Mrays/s line from the new binary" >&2; exit 1; }
+  ab_report "$i" "$a" "$b"
 done
-awk -v s="$sum" -v n="$rounds" 'BEGIN { printf "mean new/old %.3f over %d rounds\n", s / n, n }'
+ab_summary "$rounds"

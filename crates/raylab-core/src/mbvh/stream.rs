@@ -82,17 +82,15 @@ impl Hot {
     }
 }
 
-/// Entry distances and hit masks of `B::LANES / 4` rays against the four boxes of `node`, ray `j` in lanes
-/// `4j..4j + 4`: per lane exactly the operations of the single-ray slab test (`RaySlab::test`), the planes
-/// put in entry order by the direction's signs with selects instead of branches, as rays in a group differ.
+/// Entry distances and hit masks of `B::LANES / 4` rays (one or two: `rays[0]`, then `rays[1]`) against the
+/// four boxes of `node`, ray `j` in lanes `4j..4j + 4`: per lane exactly the operations of the single-ray slab
+/// test (`RaySlab::test`), the planes put in entry order by the direction's signs with selects instead of
+/// branches, as rays in a group differ.
 #[inline(always)]
-fn test_boxes<B: Vf32>(node: &MbvhNode, rays: &[&Hot]) -> (B, B::Mask) {
-    let (mut first, mut second) = ([&rays[0].rows[0]; 4], [&rays[0].rows[1]; 4]);
-    for (g, ray) in rays.iter().enumerate() {
-        (first[g], second[g]) = (&ray.rows[0], &ray.rows[1]);
-    }
-    let [ox, oy, oz, tmin] = B::splat_rows(&first[..rays.len()]);
-    let [ix, iy, iz, best] = B::splat_rows(&second[..rays.len()]);
+fn test_boxes<B: Vf32>(node: &MbvhNode, rays: [&Hot; 2]) -> (B, B::Mask) {
+    let per_test = B::LANES / 4;
+    let [ox, oy, oz, tmin] = B::splat_rows(&[&rays[0].rows[0], &rays[1].rows[0]][..per_test]);
+    let [ix, iy, iz, best] = B::splat_rows(&[&rays[0].rows[1], &rays[1].rows[1]][..per_test]);
     let (org, inv) = ([ox, oy, oz], [ix, iy, iz]);
     let zero = B::splat(0.0);
     let (mut near, mut far) = (tmin, best);
@@ -261,11 +259,11 @@ impl Mbvh {
                 }
             }
             box_tests += n as u64;
-            // The task's rays are taken `B::LANES` at a time: up to four box tests of `per_test` consecutive
-            // rays each, whose hit flags a 4x4 transpose regroups per child lane, so that each lane's hitting
-            // rays are left-packed onto its stack by one vector store. That happens in place: a lane's top
-            // never passes the next ray to read, since each ray pushes at most one entry per lane, and the
-            // vector's rays were copied out before any store.
+            // The task's rays are taken `B::LANES` at a time: four box tests of `per_test` (one or two)
+            // consecutive rays each, whose hit flags a 4x4 transpose regroups per child lane, so that each
+            // lane's hitting rays are left-packed onto its stack by one vector store. That happens in place: a
+            // lane's top never passes the next ray to read, since each ray pushes at most one entry per lane,
+            // and the vector's rays were copied out before any store.
             let [l0, l1, l2, l3] = &mut lanes;
             let mut stacks = [&mut l0[..], &mut l1[..], &mut l2[..], &mut l3[..]];
             let mut tops = top;
@@ -286,14 +284,12 @@ impl Mbvh {
                 let mut flags = [zero; 4];
                 for (p, flags) in flags.iter_mut().enumerate().take(rem.div_ceil(per_test)) {
                     let a = per_test * p;
-                    // Past the chunk's last ray, groups repeat it, and their hits are masked off.
-                    let mut rays = [&hot[ids[a] as usize]; 4];
-                    for (g, ray) in rays.iter_mut().enumerate().take(per_test).skip(1) {
-                        *ray = &hot[ids[(a + g).min(rem - 1)] as usize];
-                    }
-                    let (near, mut hit) = test_boxes::<B>(node, &rays[..per_test]);
+                    // A chunk's odd last ray, when two share a test, is tested twice and the copy's hits are
+                    // masked off.
+                    let second = ids[(a + 1).min(rem - 1)];
+                    let (near, mut hit) = test_boxes::<B>(node, [&hot[ids[a] as usize], &hot[second as usize]]);
                     if a + per_test > rem {
-                        hit = hit & B::Mask::from_bits((1 << (4 * (rem - a))) - 1);
+                        hit = hit & B::Mask::from_bits(0xF);
                     }
                     lengths = lengths + B::select(hit, near, zero);
                     *flags = B::select(hit, flag, zero);
