@@ -10,7 +10,7 @@
 
 use std::ops::Range;
 
-use raylab_simd::{VMask, Vf32};
+use raylab_simd::{Kernel, VMask, Vf32};
 
 use super::Mbvh;
 use super::node::MbvhNode;
@@ -69,15 +69,108 @@ const SHALLOW_STACK: usize = 64;
 /// Deepest tree the shallow stack serves (three entries a level, plus the root's four).
 const SHALLOW_DEPTH: usize = (SHALLOW_STACK - 4) / 3;
 
+/// What a walk does at each leaf it reaches ([`Mbvh::walk`]). A trait rather than a closure: a closure is
+/// compiled on its own, for the x86-64 baseline, and called at every leaf, while this is inlined into the
+/// SIMD entry point with the walk.
+trait Leaves {
+    /// Tests the leaf's triangles in `slots` (positions in `tri_ids` and in the leaf-ordered triangles), may
+    /// lower `limit` (the farthest distance still of interest), and returns true to stop the walk.
+    fn visit(&mut self, slots: Range<usize>, limit: &mut f32) -> bool;
+}
+
+/// Leaves of a closest-hit walk: every leaf may hold a closer hit.
+struct Closest<'a, V: Vf32> {
+    mbvh: &'a Mbvh,
+    shear: ShearX4<V>,
+    tmin: f32,
+    best_t: f32,
+    best: Option<Hit>,
+    tests: u64,
+}
+
+impl<V: Vf32> Leaves for Closest<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, slots: Range<usize>, limit: &mut f32) -> bool {
+        self.tests += slots.len() as u64;
+        self.mbvh.closest_in_leaf(&self.shear, slots, self.tmin, &mut self.best_t, &mut self.best);
+        *limit = hit_reach(self.best_t);
+        false
+    }
+}
+
+/// Leaves of an occlusion walk: the first blocker ends it.
+struct Blocker<'a, V: Vf32> {
+    mbvh: &'a Mbvh,
+    shear: ShearX4<V>,
+    tmin: f32,
+    tmax: f32,
+    found: Option<u32>,
+    tests: u64,
+}
+
+impl<V: Vf32> Leaves for Blocker<'_, V> {
+    #[inline(always)]
+    fn visit(&mut self, slots: Range<usize>, _: &mut f32) -> bool {
+        let (found, n) = self.mbvh.blocker_in_leaf(&self.shear, slots, self.tmin, self.tmax);
+        self.tests += n;
+        self.found = found;
+        found.is_some()
+    }
+}
+
+/// One ray's walk through [`raylab_simd::dispatch`]: on AVX2 CPUs the four-wide box and triangle tests are
+/// compiled inside the AVX2 entry point (VEX encodings, SSE4.1's blends inlined); the node and leaf layouts
+/// are four wide, so wider backends run them with SSE's lane type.
+struct SingleRay<'a> {
+    mbvh: &'a Mbvh,
+    ray: &'a Ray,
+    stats: &'a mut TraversalStats,
+    shadow: bool,
+}
+
+/// What a [`SingleRay`] walk found: the closest hit, or the first blocker.
+enum Found {
+    Hit(Option<Hit>),
+    Blocker(Option<u32>),
+}
+
+impl Kernel for SingleRay<'_> {
+    type Output = Found;
+    #[inline(always)]
+    fn run<V: Vf32>(self) -> Found {
+        #[cfg(target_arch = "x86_64")]
+        if V::LANES > 4 {
+            return self.walk::<raylab_simd::sse::F32x4>();
+        }
+        self.walk::<V>()
+    }
+}
+
+impl SingleRay<'_> {
+    #[inline(always)]
+    fn walk<V: Vf32>(self) -> Found {
+        let Self { mbvh, ray, stats, shadow } = self;
+        let shear = ShearX4::<V>::new(&RayShear::new(ray));
+        if shadow {
+            let mut leaves = Blocker { mbvh, shear, tmin: ray.tmin, tmax: ray.tmax, found: None, tests: 0 };
+            mbvh.walk_sized::<V>(ray, stats, &mut leaves);
+            stats.isect_tests += leaves.tests;
+            Found::Blocker(leaves.found)
+        } else {
+            let mut leaves = Closest { mbvh, shear, tmin: ray.tmin, best_t: ray.tmax, best: None, tests: 0 };
+            mbvh.walk_sized::<V>(ray, stats, &mut leaves);
+            stats.isect_tests += leaves.tests;
+            Found::Hit(leaves.best)
+        }
+    }
+}
+
 impl Mbvh {
     /// The closest hit along `ray` in `(tmin, tmax]`.
     pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        match self.backend {
-            #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 | raylab_simd::Backend::Avx512 => {
-                self.intersect_with::<raylab_simd::sse::F32x4>(ray, stats)
-            }
-            _ => self.intersect_with::<raylab_simd::scalar::F32x4>(ray, stats),
+        match self.single_ray(ray, stats, false) {
+            Found::Hit(hit) => hit,
+            Found::Blocker(_) => unreachable!("a closest-hit walk reports a hit"),
         }
     }
 
@@ -86,20 +179,16 @@ impl Mbvh {
         self.occluder(ray, stats).is_some()
     }
 
-    fn intersect_with<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        let shear = ShearX4::<V>::new(&RayShear::new(ray));
-        let mut best: Option<Hit> = None;
-        let mut best_t = ray.tmax;
-        let mut tests = 0u64;
-        let mut leaf = |slots: Range<usize>, limit: &mut f32| {
-            tests += slots.len() as u64;
-            self.closest_in_leaf(&shear, slots, ray.tmin, &mut best_t, &mut best);
-            *limit = hit_reach(best_t);
-            false
-        };
-        self.walk_sized::<V>(ray, stats, &mut leaf);
-        stats.isect_tests += tests;
-        best
+    /// The first blocker found along `ray` (not necessarily the nearest), for the shadow cache.
+    pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
+        match self.single_ray(ray, stats, true) {
+            Found::Blocker(tri) => tri,
+            Found::Hit(_) => unreachable!("an occlusion walk reports a blocker"),
+        }
+    }
+
+    fn single_ray(&self, ray: &Ray, stats: &mut TraversalStats, shadow: bool) -> Found {
+        raylab_simd::dispatch(self.backend.at_most_eight_lanes(), SingleRay { mbvh: self, ray, stats, shadow })
     }
 
     /// [`tri4::closest_in_leaf`] on this tree's blocks.
@@ -140,40 +229,9 @@ impl Mbvh {
             && RayShear::new(ray).intersect(self.tris.get(self.slot_of[tri as usize]), ray.tmin, ray.tmax).is_some()
     }
 
-    /// The first blocker found along `ray` (not necessarily the nearest), for the shadow cache.
-    pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
-        match self.backend {
-            #[cfg(target_arch = "x86_64")]
-            raylab_simd::Backend::Sse | raylab_simd::Backend::Avx2 | raylab_simd::Backend::Avx512 => {
-                self.occluder_with::<raylab_simd::sse::F32x4>(ray, stats)
-            }
-            _ => self.occluder_with::<raylab_simd::scalar::F32x4>(ray, stats),
-        }
-    }
-
-    fn occluder_with<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
-        let shear = ShearX4::<V>::new(&RayShear::new(ray));
-        let mut blocker = None;
-        let mut tests = 0u64;
-        let mut leaf = |slots: Range<usize>, _: &mut f32| {
-            let (found, n) = self.blocker_in_leaf(&shear, slots, ray.tmin, ray.tmax);
-            tests += n;
-            blocker = found;
-            found.is_some()
-        };
-        self.walk_sized::<V>(ray, stats, &mut leaf);
-        stats.isect_tests += tests;
-        blocker
-    }
-
     /// [`Mbvh::walk`] with the smallest stack this tree needs.
     #[inline(always)]
-    fn walk_sized<V: Vf32>(
-        &self,
-        ray: &Ray,
-        stats: &mut TraversalStats,
-        leaf: &mut impl FnMut(Range<usize>, &mut f32) -> bool,
-    ) {
+    fn walk_sized<V: Vf32>(&self, ray: &Ray, stats: &mut TraversalStats, leaf: &mut impl Leaves) {
         if self.depth <= SHALLOW_DEPTH {
             self.walk::<V, SHALLOW_STACK>(ray, stats, leaf);
         } else {
@@ -181,16 +239,9 @@ impl Mbvh {
         }
     }
 
-    /// Walks the leaves `ray` reaches, nearest child first; `leaf(slots, limit)` tests a leaf's triangles
-    /// (positions in `tri_ids` and in the leaf-ordered triangles),
-    /// may lower `limit` (the farthest distance still of interest), and returns true to stop.
+    /// Walks the leaves `ray` reaches, nearest child first, handing each to `leaf` ([`Leaves::visit`]).
     #[inline(always)]
-    fn walk<V: Vf32, const STACK: usize>(
-        &self,
-        ray: &Ray,
-        stats: &mut TraversalStats,
-        leaf: &mut impl FnMut(Range<usize>, &mut f32) -> bool,
-    ) {
+    fn walk<V: Vf32, const STACK: usize>(&self, ray: &Ray, stats: &mut TraversalStats, leaf: &mut impl Leaves) {
         stats.rays += 1;
         stats.packets += 1;
         if self.tri_ids.is_empty() || !ray.is_valid() {
@@ -251,7 +302,7 @@ impl Mbvh {
             } else {
                 leaves += 1;
                 let slots = cur.child as usize..(cur.child + cur.count) as usize;
-                if leaf(slots, &mut limit) {
+                if leaf.visit(slots, &mut limit) {
                     break 'walk;
                 }
             }
@@ -280,6 +331,16 @@ mod tests {
     use super::*;
     use crate::scene::{SceneBuilder, Triangle};
 
+    /// Records the first slot of every leaf a walk visits.
+    struct Record(Vec<usize>);
+
+    impl Leaves for Record {
+        fn visit(&mut self, slots: Range<usize>, _: &mut f32) -> bool {
+            self.0.push(slots.start);
+            false
+        }
+    }
+
     /// The deep-tree stack walks exactly like the shallow one.
     #[test]
     fn both_stack_sizes_walk_alike() {
@@ -294,21 +355,12 @@ mod tests {
         for k in 0..200 {
             let a = k as f32 * 0.37;
             let ray = Ray::new(Vec3::new(a.sin() * 3.0 + 8.0, a.cos() * 4.0 + 9.0, 5.0), Vec3::new(0.1, -0.05, -1.0));
-            let mut leaves = (Vec::new(), Vec::new());
+            let (mut shallow, mut deep) = (Record(Vec::new()), Record(Vec::new()));
             let mut s = TraversalStats::default();
-            m.walk::<raylab_simd::scalar::F32x4, SHALLOW_STACK>(
-                &ray,
-                &mut s,
-                &mut |slots: Range<usize>, _: &mut f32| {
-                    leaves.0.push(slots.start);
-                    false
-                },
-            );
-            m.walk::<raylab_simd::scalar::F32x4, DEEP_STACK>(&ray, &mut s, &mut |slots: Range<usize>, _: &mut f32| {
-                leaves.1.push(slots.start);
-                false
-            });
-            assert_eq!(leaves.0, leaves.1);
+            m.walk::<raylab_simd::scalar::F32x4, SHALLOW_STACK>(&ray, &mut s, &mut shallow);
+            m.walk::<raylab_simd::scalar::F32x4, DEEP_STACK>(&ray, &mut s, &mut deep);
+            assert!(k > 0 || !shallow.0.is_empty(), "the first ray reaches leaves");
+            assert_eq!(shallow.0, deep.0);
         }
     }
 }
