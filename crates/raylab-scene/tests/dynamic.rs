@@ -7,7 +7,7 @@ use common::{adversarial_rays, check_hits};
 use glam::Vec3;
 use raylab_core::dacrt::Dacrt;
 use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::mbvh::Mbvh;
+use raylab_core::mbvh::{Mbvh, MbvhParams};
 use raylab_core::ray::Ray;
 use raylab_core::scene::SceneBuilder;
 use raylab_scene::animation::Animation;
@@ -21,6 +21,8 @@ fn every_structure_follows_the_motion() {
     assert_eq!(scene.triangle_count(), base.triangle_count() + anim.moving_triangles());
     let rest = scene.positions.clone();
     let mut mbvh = Mbvh::build(&scene);
+    // Spatial splits everywhere: leaves hold clipped parts of triangles, which a refit grows to whole ones.
+    let mut spatial = Mbvh::build_with(&scene, &MbvhParams { spatial_min_refs: 0, ..MbvhParams::default() });
     let first_moving = base.positions.len();
     for (k, t) in [0.3f32, 1.1, 2.9].into_iter().enumerate() {
         anim.apply(&mut scene, t).unwrap();
@@ -28,6 +30,7 @@ fn every_structure_follows_the_motion() {
         assert!(scene.positions[first_moving..] != rest[first_moving..], "t = {t}: the objects moved");
         let refit = mbvh.refit(&scene).unwrap();
         assert!(refit.as_secs_f64() < 1.0);
+        spatial.refit(&scene).unwrap();
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
         let dacrt = Dacrt::new(&scene);
         // Rays aimed at the moving objects' vertices and random rays.
@@ -36,6 +39,7 @@ fn every_structure_follows_the_motion() {
         rays.extend(scene.positions[first_moving..].iter().step_by(7).map(|&p| Ray::new(eye, p - eye)));
         let what = format!("t = {t}");
         check_hits(&scene, &mbvh, &rays, &format!("refitted MBVH, {what}"));
+        check_hits(&scene, &spatial, &rays, &format!("refitted MBVH with spatial splits, {what}"));
         check_hits(&scene, &kd, &rays, &format!("rebuilt kd-tree, {what}"));
         check_hits(&scene, &dacrt, &rays[..400], &format!("DACRT, {what}"));
     }

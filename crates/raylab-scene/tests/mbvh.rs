@@ -7,7 +7,7 @@ mod common;
 use common::{adversarial_rays, check_hits, incoherent, scaled_scenes};
 use glam::Vec3;
 use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::mbvh::{EMPTY, Mbvh};
+use raylab_core::mbvh::{EMPTY, Mbvh, MbvhParams};
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
 use raylab_core::scene::{SceneBuilder, Triangle};
@@ -16,17 +16,28 @@ use raylab_scene::builtin::{self, Detail};
 use raylab_scene::mesh::Jitter;
 use raylab_simd::Backend;
 
+/// Spatial splits tried at every node, so that the test scenes (smaller than the default's limit) get them.
+fn spatial_everywhere() -> MbvhParams {
+    MbvhParams { spatial_min_refs: 0, ..MbvhParams::default() }
+}
+
+/// The trees each test checks: the default build and one with spatial splits everywhere.
+fn trees(scene: &raylab_core::scene::Scene) -> [(&'static str, Mbvh); 2] {
+    [("default", Mbvh::build(scene)), ("spatial", Mbvh::build_with(scene, &spatial_everywhere()))]
+}
+
 #[test]
 fn mbvh_matches_brute_force_on_every_builtin_scene_and_backend() {
     for name in builtin::names() {
         let scene = builtin::build(name, Detail::Test).unwrap();
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-        let mut m = Mbvh::build(&scene);
-        for backend in Backend::available() {
-            m.backend = backend;
-            let what = format!("{name} {}", backend.name());
-            check_hits(&scene, &m, &adversarial_rays(&scene, &kd, 200, 3), &what);
-            check_hits(&scene, &m, &incoherent(&scene, 3000, 11), &what);
+        for (tree, mut m) in trees(&scene) {
+            for backend in Backend::available() {
+                m.backend = backend;
+                let what = format!("{name} {tree} {}", backend.name());
+                check_hits(&scene, &m, &adversarial_rays(&scene, &kd, 200, 3), &what);
+                check_hits(&scene, &m, &incoherent(&scene, 3000, 11), &what);
+            }
         }
     }
 }
@@ -100,40 +111,61 @@ fn empty_scene_single_triangle_and_extreme_coordinates() {
     );
 
     for (name, scene) in scaled_scenes() {
-        let m = Mbvh::build(&scene);
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-        check_hits(&scene, &m, &adversarial_rays(&scene, &kd, 100, 9), &name);
+        for (tree, m) in trees(&scene) {
+            check_hits(&scene, &m, &adversarial_rays(&scene, &kd, 100, 9), &format!("{name} {tree}"));
+        }
     }
 }
 
+/// Every triangle is in at least one leaf and at most once in each; spatial splits put some in several,
+/// and every point of a triangle lies in the box of one of its leaves.
 #[test]
-fn every_triangle_is_in_exactly_one_leaf_and_lanes_are_well_formed() {
+fn every_triangle_is_covered_by_its_leaves_and_lanes_are_well_formed() {
     let scene = builtin::build("kitchen", Detail::Test).unwrap();
-    let m = Mbvh::build(&scene);
-    let mut seen = vec![0u32; scene.triangle_count()];
-    for n in m.nodes() {
-        for k in 0..4 {
-            if n.is_leaf(k) {
-                for &id in &m.tri_ids()[n.child[k] as usize..(n.child[k] + n.count[k]) as usize] {
-                    seen[id as usize] += 1;
-                    let b = scene.triangle_bounds(id as usize);
-                    for a in 0..3 {
-                        assert!(n.min[a][k] <= b.min[a] && b.max[a] <= n.max[a][k], "leaf box holds its triangles");
+    for (tree, m) in trees(&scene) {
+        let mut boxes: Vec<Vec<([f32; 3], [f32; 3])>> = vec![Vec::new(); scene.triangle_count()];
+        for n in m.nodes() {
+            for k in 0..4 {
+                if n.is_leaf(k) {
+                    let ids = &m.tri_ids()[n.child[k] as usize..(n.child[k] + n.count[k]) as usize];
+                    for (j, &id) in ids.iter().enumerate() {
+                        assert!(!ids[..j].contains(&id), "{tree}: triangle {id} twice in one leaf");
+                        boxes[id as usize].push(([0, 1, 2].map(|a| n.min[a][k]), [0, 1, 2].map(|a| n.max[a][k])));
                     }
+                } else if !n.is_empty(k) {
+                    assert!((n.child[k] as usize) < m.nodes().len());
                 }
-            } else if !n.is_empty(k) {
-                assert!((n.child[k] as usize) < m.nodes().len());
             }
         }
-    }
-    assert!(seen.iter().all(|&c| c == 1));
-    let st = m.stats();
-    assert!(st.lane_fill_percent > 60.0 && st.depth > 2, "{st:?}");
-    // The brute-force reference agrees on a few hundred more random rays.
-    let bf = BruteForce::new(&scene);
-    let mut s = TraversalStats::default();
-    for r in incoherent(&scene, 300, 2) {
-        assert_eq!(m.intersect(&r, &mut s).map(|h| h.t), bf.intersect(&r, &mut s).map(|h| h.t), "{r:?}");
+        for (id, leaf_boxes) in boxes.iter().enumerate() {
+            assert!(!leaf_boxes.is_empty(), "{tree}: triangle {id} is in no leaf");
+            let [a, b, c] = scene.vertices(id);
+            for i in 0..=6 {
+                for j in 0..=6 - i {
+                    let (u, v) = (i as f32 / 6.0, j as f32 / 6.0);
+                    let p = a + (b - a) * u + (c - a) * v;
+                    let inside = |(lo, hi): &([f32; 3], [f32; 3])| (0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k]);
+                    assert!(
+                        leaf_boxes.iter().any(inside),
+                        "{tree}: point {p} of triangle {id} is in none of its leaves"
+                    );
+                }
+            }
+        }
+        let st = m.stats();
+        assert!(st.lane_fill_percent > 60.0 && st.depth > 2, "{tree}: {st:?}");
+        let copies = st.references - scene.triangle_count();
+        if tree == "spatial" {
+            assert!(copies > 0, "spatial splits cut no triangle: {st:?}");
+            assert!(st.references as f32 <= scene.triangle_count() as f32 * 1.3, "over the budget: {st:?}");
+        }
+        // The brute-force reference agrees on a few hundred more random rays.
+        let bf = BruteForce::new(&scene);
+        let mut s = TraversalStats::default();
+        for r in incoherent(&scene, 300, 2) {
+            assert_eq!(m.intersect(&r, &mut s).map(|h| h.t), bf.intersect(&r, &mut s).map(|h| h.t), "{tree}: {r:?}");
+        }
     }
 }
 
@@ -169,10 +201,13 @@ fn ray_streams_match_brute_force() {
         };
         // Every backend: eight lanes test two rays per node, four one, a task's rays eight or four at a time
         // (odd and partial last chunks included).
+        // Both trees: the default build and one with spatial splits everywhere.
         let cases = Backend::available().into_iter().flat_map(|b| {
             [(16, true), (256, true), (256, false), (4095, true)].into_iter().map(move |(g, o)| (b, g, o))
         });
-        for (backend, group, ordered) in cases {
+        let spatial = Mbvh::build_with(&scene, &spatial_everywhere());
+        let cases = cases.flat_map(|c| [("default", &m, c), ("spatial", &spatial, c)]);
+        for (tree, m, (backend, group, ordered)) in cases {
             let opts = TraceOptions { method: Method::MbvhRs, stream_order: ordered, ..TraceOptions::default() };
             let mut m = m.clone();
             m.backend = backend;
@@ -183,7 +218,7 @@ fn ray_streams_match_brute_force() {
                 let mut blocked = vec![false; chunk.len()];
                 tracer.intersect_tile(chunk, chunk.len(), 1, &mut hits, &mut s);
                 tracer.occluded_tile(chunk, chunk.len(), 1, None, &mut blocked, &mut s);
-                check(&format!("group {group}"), chunk, &hits, &blocked);
+                check(&format!("{tree} tree, group {group}"), chunk, &hits, &blocked);
             }
             assert_eq!(s.rays, 2 * total);
             assert!(s.box_tests > 0 && s.leaf_rays > 0);

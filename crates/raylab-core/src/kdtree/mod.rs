@@ -1,7 +1,7 @@
 //! The SAH kd-tree (Tsakok 2008, chapters 2-3): build, compact layout, statistics and traversal kernels.
 
 mod build;
-mod clip;
+pub(crate) mod clip;
 mod edge_width;
 pub mod frustum;
 mod leaf_bounds;

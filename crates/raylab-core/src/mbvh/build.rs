@@ -1,28 +1,58 @@
-//! Building the 4-wide MBVH: a binary BVH by binned SAH over triangle centroids (16 bins on each of the three
-//! centroid axes, the halves built in parallel with rayon), then collapsed top-down into 4-wide nodes by
+//! Building the 4-wide MBVH: a binary BVH by binned SAH with spatial splits (the SBVH of Stich, Friedrich and
+//! Dietrich 2009), the halves built in parallel with rayon, then collapsed top-down into 4-wide nodes by
 //! repeatedly opening the child with the largest surface area (Wald et al. 2008, as the MBVH RS paper builds).
+//!
+//! Each node first looks for an object split: 16 bins on each of the three axes of its references'
+//! centroids. Where the two halves of the best one overlap by more than [`SPATIAL_OVERLAP`] of the root's
+//! area (long or diagonal triangles, which make boxes overlap and rays visit both), it also bins space: 16
+//! equal slabs of the node's box per axis, each triangle cut into every slab it crosses. A plane between
+//! slabs may then cut triangles, which go to both sides as references clipped exactly to each
+//! ([`crate::kdtree::clip::split_clipped_bounds`], the kd-tree's perfect-split clipping). The cheaper split by
+//! the SAH wins; [`MbvhParams`] limits spatial splits to large nodes and bounds the copies they make. Embree's
+//! high-quality builder, which the harness uses, makes the same kind of tree.
 
 use glam::{UVec3, Vec3, Vec3A};
+use rayon::prelude::*;
 
+use super::MbvhParams;
 use super::node::{EMPTY, MbvhNode};
-use crate::aabb::Aabb;
+use crate::aabb::{Aabb, coord, coord_mut};
+use crate::kdtree::clip::split_clipped_bounds;
 use crate::tri4;
 
 /// Triangles per leaf above which a node is always split.
 pub const MAX_LEAF: usize = 8;
-/// SAH bins per node.
+/// SAH bins per node and axis, for object and for spatial splits.
 const BINS: usize = 16;
 /// Cost of a box test relative to a triangle test in the SAH.
 const C_TRAV: f32 = 1.0;
 /// Binary depth from which lists are halved instead of split by SAH, so that the tree (and the traversal
 /// stack) stays shallow whatever the input: at most 48 SAH levels, then log2 of the rest.
 const MAX_SAH_DEPTH: u32 = 48;
-/// Nodes with at least this many triangles build their halves in parallel.
+/// Nodes with at least this many references build their halves in parallel.
 const PARALLEL_MIN: usize = 4096;
+/// Spatial splits are tried where the best object split's halves overlap by at least this fraction of the
+/// root's surface area (Stich et al.'s alpha).
+const SPATIAL_OVERLAP: f32 = 1e-5;
 
-/// A binary build node.
+/// A triangle reference: a triangle and the part of its box inside the node that holds it (the whole box,
+/// unless spatial splits cut the triangle).
+#[derive(Clone, Copy)]
+struct Ref {
+    bounds: Aabb,
+    id: u32,
+}
+
+impl Ref {
+    fn centroid(&self) -> Vec3 {
+        self.bounds.center()
+    }
+}
+
+/// A binary build node. A leaf owns its triangle ids: a triangle cut by spatial splits is in several leaves
+/// (at most once in each).
 enum Bin {
-    Leaf { bounds: Aabb, first: u32, count: u32 },
+    Leaf { bounds: Aabb, ids: Vec<u32> },
     Inner { bounds: Aabb, children: Box<[Bin; 2]> },
 }
 
@@ -31,6 +61,10 @@ impl Bin {
         match self {
             Bin::Leaf { bounds, .. } | Bin::Inner { bounds, .. } => *bounds,
         }
+    }
+
+    fn leaf(bounds: Aabb, refs: &[Ref]) -> Self {
+        Bin::Leaf { bounds, ids: refs.iter().map(|r| r.id).collect() }
     }
 }
 
@@ -42,29 +76,49 @@ pub struct Built {
     pub tri_ids: Vec<u32>,
     /// Nodes of the binary BVH before collapsing (for statistics).
     pub binary_nodes: usize,
+    /// Triangle references in the leaves, padding aside (the triangle count plus the spatial splits' copies).
+    pub references: usize,
 }
 
-/// Builds over triangles given by their bounds and centroids.
-pub fn build(boxes: &[Aabb], centroids: &[Vec3]) -> Built {
-    let mut ids: Vec<u32> = (0..boxes.len() as u32).collect();
+/// What every level of the build reads.
+struct Context<'a> {
+    tris: &'a [[Vec3; 3]],
+    /// Surface area of the root's box, the measure of [`SPATIAL_OVERLAP`].
+    root_area: f32,
+    /// Nodes with fewer references make object splits only.
+    spatial_min: usize,
+}
+
+/// Builds over triangles given by their corners.
+pub fn build(tris: &[[Vec3; 3]], params: &MbvhParams) -> Built {
+    let refs: Vec<Ref> = tris
+        .iter()
+        .enumerate()
+        .map(|(i, t)| Ref { bounds: Aabb::from_points(t.iter().copied()), id: i as u32 })
+        .collect();
     let mut count = 0usize;
-    let root = if ids.is_empty() {
-        Bin::Leaf { bounds: Aabb::EMPTY, first: 0, count: 0 }
+    let root = if refs.is_empty() {
+        Bin::Leaf { bounds: Aabb::EMPTY, ids: Vec::new() }
     } else {
-        let extent = Extent::of(boxes, centroids, &ids);
-        split(boxes, centroids, &mut ids, extent, 0, 0, &mut count)
+        let extent = Extent::of(&refs);
+        let ctx = Context { tris, root_area: area(&extent.bounds), spatial_min: params.spatial_min_refs };
+        let budget = (refs.len() as f64 * params.split_budget.max(1.0) as f64) as usize;
+        split(&ctx, refs, extent, 0, budget, &mut count)
     };
     let mut nodes = vec![MbvhNode::empty()];
+    let mut ids = Vec::new();
     match &root {
-        Bin::Leaf { bounds, first, count } => {
-            if *count > 0 {
-                put(&mut nodes[0], 0, bounds, *first, *count);
+        Bin::Leaf { bounds, ids: leaf } => {
+            if !leaf.is_empty() {
+                put(&mut nodes[0], 0, bounds, 0, leaf.len() as u32);
+                ids.extend_from_slice(leaf);
             }
         }
-        Bin::Inner { .. } => collapse(&root, 0, &mut nodes),
+        Bin::Inner { .. } => collapse(&root, 0, &mut nodes, &mut ids),
     }
+    let references = ids.len();
     let tri_ids = align_leaves(&mut nodes, &ids);
-    Built { nodes, tri_ids, binary_nodes: count }
+    Built { nodes, tri_ids, binary_nodes: count, references }
 }
 
 /// Aligns every leaf's ids on a four-triangle block ([`tri4::align_leaves`]).
@@ -95,8 +149,8 @@ fn put(node: &mut MbvhNode, k: usize, b: &Aabb, first: u32, count: u32) {
 }
 
 /// Fills node `at` from binary inner node `n`: up to four grandchildren, opening the largest inner child
-/// first; inner lanes recurse into new nodes.
-fn collapse(n: &Bin, at: usize, nodes: &mut Vec<MbvhNode>) {
+/// first; inner lanes recurse into new nodes, leaves append their ids to `ids` (in depth-first order).
+fn collapse(n: &Bin, at: usize, nodes: &mut Vec<MbvhNode>, ids: &mut Vec<u32>) {
     let Bin::Inner { children, .. } = n else { return };
     let mut lanes: Vec<&Bin> = vec![&children[0], &children[1]];
     while lanes.len() < 4 {
@@ -113,19 +167,22 @@ fn collapse(n: &Bin, at: usize, nodes: &mut Vec<MbvhNode>) {
     }
     for (k, lane) in lanes.into_iter().enumerate() {
         match lane {
-            Bin::Leaf { bounds, first, count } => put(&mut nodes[at], k, bounds, *first, *count),
+            Bin::Leaf { bounds, ids: leaf } => {
+                put(&mut nodes[at], k, bounds, ids.len() as u32, leaf.len() as u32);
+                ids.extend_from_slice(leaf);
+            }
             Bin::Inner { bounds, .. } => {
                 let index = nodes.len();
                 nodes.push(MbvhNode::empty());
                 put(&mut nodes[at], k, bounds, index as u32, 0);
-                collapse(lane, index, nodes);
+                collapse(lane, index, nodes, ids);
             }
         }
     }
     debug_assert!(nodes[at].child.iter().any(|&c| c != EMPTY));
 }
 
-/// The box of some triangles and the box of their centroids.
+/// The box of some references and the box of their centroids.
 #[derive(Clone, Copy)]
 struct Extent {
     bounds: Aabb,
@@ -133,90 +190,316 @@ struct Extent {
 }
 
 impl Extent {
-    /// The extent of triangles `ids`, by a pass over them.
-    fn of(boxes: &[Aabb], centroids: &[Vec3], ids: &[u32]) -> Self {
-        ids.iter().fold(Extent { bounds: Aabb::EMPTY, centroids: Aabb::EMPTY }, |e, &i| Extent {
-            bounds: e.bounds.union(boxes[i as usize]),
-            centroids: e.centroids.grow(centroids[i as usize]),
+    /// The extent of `refs`, by a pass over them.
+    fn of(refs: &[Ref]) -> Self {
+        refs.iter().fold(Extent { bounds: Aabb::EMPTY, centroids: Aabb::EMPTY }, |e, r| Extent {
+            bounds: e.bounds.union(r.bounds),
+            centroids: e.centroids.grow(r.centroid()),
         })
     }
 }
 
-/// Builds the binary subtree over `ids` (which start at `offset` in the final id array and span `extent`),
-/// partitioning `ids` in place. A binned split hands each child its extent: the triangle boxes from the
-/// bins, the centroid boxes from the partition pass, so no level makes a pass of its own to find them.
-fn split(
-    boxes: &[Aabb],
-    centroids: &[Vec3],
-    ids: &mut [u32],
-    extent: Extent,
-    offset: u32,
-    depth: u32,
-    nodes: &mut usize,
-) -> Bin {
+/// Two children's references and extents.
+type Parts = (Vec<Ref>, Extent, Vec<Ref>, Extent);
+
+/// Builds the binary subtree over `refs` (spanning `extent`), which may hold at most `budget` references
+/// in all: what spatial splits may copy. An object split hands each child its extent, the reference boxes
+/// from the bins and the centroid boxes from the partition pass, so no level makes a pass of its own to find
+/// them.
+fn split(ctx: &Context, mut refs: Vec<Ref>, extent: Extent, depth: u32, budget: usize, nodes: &mut usize) -> Bin {
     *nodes += 1;
     let bounds = extent.bounds;
-    let n = ids.len();
-    let leaf = Bin::Leaf { bounds, first: offset, count: n as u32 };
+    let n = refs.len();
     if n <= 2 {
-        return leaf;
+        return Bin::leaf(bounds, &refs);
     }
     // Deep in the tree (lopsided SAH splits on pathological input), the list is halved to bound the depth.
-    let binned = if depth >= MAX_SAH_DEPTH {
+    // Otherwise split when it beats a leaf, and always when the leaf would be too big.
+    let choice = if depth >= MAX_SAH_DEPTH {
         None
     } else {
-        // Split when it beats a leaf, and always when the leaf would be too big.
-        best_split(boxes, centroids, ids, &extent.centroids, bounds).filter(|s| s.cost < n as f32 || n > MAX_LEAF)
+        choose(ctx, &refs, &extent, budget).filter(|c| c.cost() < n as f32 || n > MAX_LEAF)
     };
-    let parts = match binned {
-        Some(s) => {
-            let (axis, lo) = (s.axis, extent.centroids.min[s.axis]);
-            let (mut left_c, mut right_c) = (Aabb::EMPTY, Aabb::EMPTY);
-            let mut mid = 0;
-            for j in 0..n {
-                let c = centroids[ids[j] as usize];
-                if bin_of(c[axis], lo, s.scale) <= s.bin {
-                    left_c = left_c.grow(c);
-                    ids.swap(mid, j);
-                    mid += 1;
-                } else {
-                    right_c = right_c.grow(c);
-                }
-            }
-            (mid > 0 && mid < n).then_some((
-                mid,
-                Extent { bounds: s.left, centroids: left_c },
-                Extent { bounds: s.right, centroids: right_c },
-            ))
-        }
-        None if n <= MAX_LEAF => return leaf,
+    let parts = match choice {
+        Some(Choice::Object(s)) => partition_objects(&mut refs, &extent, &s),
+        Some(Choice::Spatial(s)) => partition_space(ctx, &refs, &s),
+        None if n <= MAX_LEAF => return Bin::leaf(bounds, &refs),
         None => None,
     };
-    let (mid, left_extent, right_extent) = match parts {
+    let (left, left_extent, right, right_extent) = match parts {
         Some(p) => p,
         // All centroids in one bin (or the depth cap): split the list in half.
         None if n > MAX_LEAF => {
-            let mid = n / 2;
-            (mid, Extent::of(boxes, centroids, &ids[..mid]), Extent::of(boxes, centroids, &ids[mid..]))
+            let right = refs.split_off(n / 2);
+            let (le, re) = (Extent::of(&refs), Extent::of(&right));
+            (refs, le, right, re)
         }
-        None => return leaf,
+        None => return Bin::leaf(bounds, &refs),
     };
-    let (left, right) = ids.split_at_mut(mid);
-    let (mut nl, mut nr) = (0, 0);
-    let right_offset = offset + mid as u32;
+    // The budget left after this split's copies goes to the children in proportion to their sizes.
+    let (nl, nr) = (left.len(), right.len());
+    let spare = budget.saturating_sub(nl + nr);
+    let spare_left = spare * nl / (nl + nr);
+    let (budget_left, budget_right) = (nl + spare_left, nr + spare - spare_left);
+    let (mut count_left, mut count_right) = (0, 0);
     let (l, r) = if n >= PARALLEL_MIN {
         rayon::join(
-            || split(boxes, centroids, left, left_extent, offset, depth + 1, &mut nl),
-            || split(boxes, centroids, right, right_extent, right_offset, depth + 1, &mut nr),
+            || split(ctx, left, left_extent, depth + 1, budget_left, &mut count_left),
+            || split(ctx, right, right_extent, depth + 1, budget_right, &mut count_right),
         )
     } else {
         (
-            split(boxes, centroids, left, left_extent, offset, depth + 1, &mut nl),
-            split(boxes, centroids, right, right_extent, right_offset, depth + 1, &mut nr),
+            split(ctx, left, left_extent, depth + 1, budget_left, &mut count_left),
+            split(ctx, right, right_extent, depth + 1, budget_right, &mut count_right),
         )
     };
-    *nodes += nl + nr;
+    *nodes += count_left + count_right;
     Bin::Inner { bounds, children: Box::new([l, r]) }
+}
+
+/// A node's split: by centroid bins, or by a plane that may cut references.
+enum Choice {
+    Object(Split),
+    Spatial(SpatialSplit),
+}
+
+impl Choice {
+    fn cost(&self) -> f32 {
+        match self {
+            Choice::Object(s) => s.cost,
+            Choice::Spatial(s) => s.cost,
+        }
+    }
+}
+
+/// The cheaper of the best object split and, where that one's halves overlap and the budget allows copies,
+/// the best spatial split.
+fn choose(ctx: &Context, refs: &[Ref], extent: &Extent, budget: usize) -> Option<Choice> {
+    let object = best_split(refs, &extent.centroids, extent.bounds);
+    let overlapping =
+        object.as_ref().is_none_or(|s| area(&s.left.intersection(s.right)) > SPATIAL_OVERLAP * ctx.root_area);
+    let spatial = if refs.len() >= ctx.spatial_min && budget > refs.len() && overlapping {
+        best_spatial(ctx, refs, &extent.bounds).filter(|s| s.left_n + s.right_n <= budget)
+    } else {
+        None
+    };
+    match (object, spatial) {
+        (Some(o), Some(s)) if s.cost < o.cost => Some(Choice::Spatial(s)),
+        (Some(o), _) => Some(Choice::Object(o)),
+        (None, s) => s.map(Choice::Spatial),
+    }
+}
+
+/// Splits `refs` in place by the centroid bins of `s`; `None` when one side would be empty.
+fn partition_objects(refs: &mut Vec<Ref>, extent: &Extent, s: &Split) -> Option<Parts> {
+    let (axis, lo) = (s.axis, coord(&extent.centroids.min, s.axis));
+    let (mut left_c, mut right_c) = (Aabb::EMPTY, Aabb::EMPTY);
+    let mut mid = 0;
+    for j in 0..refs.len() {
+        let c = refs[j].centroid();
+        if bin_of(c[axis], lo, s.scale) <= s.bin {
+            left_c = left_c.grow(c);
+            refs.swap(mid, j);
+            mid += 1;
+        } else {
+            right_c = right_c.grow(c);
+        }
+    }
+    if mid == 0 || mid == refs.len() {
+        return None;
+    }
+    let right = refs.split_off(mid);
+    let left = std::mem::take(refs);
+    Some((left, Extent { bounds: s.left, centroids: left_c }, right, Extent { bounds: s.right, centroids: right_c }))
+}
+
+/// Splits `refs` by the plane of `s`: a reference on one side goes there, one the plane cuts goes to both,
+/// clipped to each; `None` when one side would be empty.
+fn partition_space(ctx: &Context, refs: &[Ref], s: &SpatialSplit) -> Option<Parts> {
+    let (mut left, mut right) = (Vec::with_capacity(s.left_n), Vec::with_capacity(s.right_n));
+    for r in refs {
+        if coord(&r.bounds.max, s.axis) <= s.pos {
+            left.push(*r);
+        } else if coord(&r.bounds.min, s.axis) >= s.pos {
+            right.push(*r);
+        } else {
+            match split_clipped_bounds(&ctx.tris[r.id as usize], &r.bounds, s.axis, s.pos) {
+                (None, None) => left.push(*r),
+                (l, rr) => {
+                    left.extend(l.map(|bounds| Ref { bounds, id: r.id }));
+                    right.extend(rr.map(|bounds| Ref { bounds, id: r.id }));
+                }
+            }
+        }
+    }
+    if left.is_empty() || right.is_empty() {
+        return None;
+    }
+    let (le, re) = (Extent::of(&left), Extent::of(&right));
+    Some((left, le, right, re))
+}
+
+/// Equal slabs of a node's box along one axis: slab `b` spans `[plane(b), plane(b + 1)]`.
+#[derive(Clone, Copy)]
+struct Slabs {
+    axis: usize,
+    lo: f32,
+    width: f32,
+}
+
+impl Slabs {
+    /// The plane between slabs `b - 1` and `b`.
+    fn plane(&self, b: usize) -> f32 {
+        self.lo + self.width * b as f32
+    }
+
+    /// The slab holding coordinate `x` (the end slabs take what lies beyond them).
+    fn of(&self, x: f32) -> usize {
+        (((x - self.lo) / self.width) as usize).min(BINS - 1)
+    }
+
+    /// Grows `boxes[first..=last]` by the parts of triangle `tri` (within `bounds`) in those slabs: each
+    /// part's box is spanned by the corners in its slab and the edges' crossings of its two planes, each
+    /// plane's crossings found once for the slabs on both sides. Single precision and only for the spatial
+    /// bins' estimates; the references a split makes are clipped exactly ([`split_clipped_bounds`]).
+    fn chop(&self, tri: &[Vec3; 3], bounds: &Aabb, first: usize, last: usize, boxes: &mut [Aabb; BINS]) {
+        let mut parts = [Aabb::EMPTY; BINS];
+        for &v in tri {
+            let b = self.of(coord(&v, self.axis)).clamp(first, last);
+            parts[b] = parts[b].grow(v);
+        }
+        let edges: [(Vec3, Vec3, f32, f32); 3] = std::array::from_fn(|k| {
+            let (v, w) = (tri[k], tri[(k + 1) % 3]);
+            let (x, y) = (coord(&v, self.axis), coord(&w, self.axis));
+            (v, w - v, x, y)
+        });
+        for b in first + 1..=last {
+            let p = self.plane(b);
+            let mut cross = Aabb::EMPTY;
+            for &(v, d, x, y) in &edges {
+                if (x < p) != (y < p) {
+                    let mut c = v + d * ((p - x) / (y - x));
+                    *coord_mut(&mut c, self.axis) = p;
+                    cross = cross.grow(c);
+                }
+            }
+            parts[b - 1] = parts[b - 1].union(cross);
+            parts[b] = parts[b].union(cross);
+        }
+        for (slab_box, part) in boxes[first..=last].iter_mut().zip(&parts[first..=last]) {
+            let part = part.intersection(*bounds);
+            if !part.is_empty() {
+                *slab_box = slab_box.union(part);
+            }
+        }
+    }
+}
+
+/// Surface area of `b`, zero when it is empty (a box empty on one axis would otherwise count its faces).
+fn area(b: &Aabb) -> f32 {
+    if b.is_empty() { 0.0 } else { b.surface_area() }
+}
+
+/// A spatial split: the plane `coord[axis] = pos`, with the references each side would get.
+struct SpatialSplit {
+    axis: usize,
+    pos: f32,
+    /// SAH cost in units of triangle tests.
+    cost: f32,
+    left_n: usize,
+    right_n: usize,
+}
+
+/// One axis's spatial bins: each slab's box of reference parts, and how many references enter (start) and
+/// leave (end) in it.
+#[derive(Clone, Copy)]
+struct SpatialBins {
+    boxes: [Aabb; BINS],
+    enter: [usize; BINS],
+    leave: [usize; BINS],
+}
+
+impl SpatialBins {
+    const EMPTY: Self = Self { boxes: [Aabb::EMPTY; BINS], enter: [0; BINS], leave: [0; BINS] };
+
+    /// Adds reference `r` of triangle `tri`.
+    fn add(&mut self, slabs: &Slabs, tri: &[Vec3; 3], r: &Ref) {
+        let (first, last) = (slabs.of(coord(&r.bounds.min, slabs.axis)), slabs.of(coord(&r.bounds.max, slabs.axis)));
+        self.enter[first] += 1;
+        self.leave[last] += 1;
+        if first == last {
+            self.boxes[first] = self.boxes[first].union(r.bounds);
+        } else {
+            slabs.chop(tri, &r.bounds, first, last, &mut self.boxes);
+        }
+    }
+
+    /// The bins of both sets of references.
+    fn merge(mut self, o: &Self) -> Self {
+        for b in 0..BINS {
+            self.boxes[b] = self.boxes[b].union(o.boxes[b]);
+            self.enter[b] += o.enter[b];
+            self.leave[b] += o.leave[b];
+        }
+        self
+    }
+}
+
+/// The spatial bins of `refs` on each axis that has slabs; large nodes bin their references in parallel.
+fn bin_space(ctx: &Context, refs: &[Ref], slabs: &[Option<Slabs>; 3]) -> [SpatialBins; 3] {
+    let bin = |refs: &[Ref]| {
+        let mut bins = [SpatialBins::EMPTY; 3];
+        for (bins, slabs) in bins.iter_mut().zip(slabs) {
+            if let Some(slabs) = slabs {
+                for r in refs {
+                    bins.add(slabs, &ctx.tris[r.id as usize], r);
+                }
+            }
+        }
+        bins
+    };
+    if refs.len() < PARALLEL_MIN {
+        return bin(refs);
+    }
+    refs.par_chunks(PARALLEL_MIN / 2)
+        .map(bin)
+        .reduce(|| [SpatialBins::EMPTY; 3], |a, b| std::array::from_fn(|k| a[k].merge(&b[k])))
+}
+
+/// The cheapest plane between [`BINS`] equal slabs of `bounds` on any axis (Stich et al.'s spatial binning):
+/// each reference is cut into every slab it crosses ([`Slabs::chop`]), and counted where it enters and where it
+/// leaves.
+fn best_spatial(ctx: &Context, refs: &[Ref], bounds: &Aabb) -> Option<SpatialSplit> {
+    let total = area(bounds).max(f32::MIN_POSITIVE);
+    let slabs: [Option<Slabs>; 3] = std::array::from_fn(|axis| {
+        let lo = coord(&bounds.min, axis);
+        let width = (coord(&bounds.max, axis) - lo) / BINS as f32;
+        (width > 0.0 && width.is_finite()).then_some(Slabs { axis, lo, width })
+    });
+    let bins = bin_space(ctx, refs, &slabs);
+    let mut best: Option<SpatialSplit> = None;
+    for (slabs, bins) in slabs.iter().zip(&bins) {
+        let Some(slabs) = slabs else { continue };
+        let mut right = [(Aabb::EMPTY, 0usize); BINS];
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
+        for b in (1..BINS).rev() {
+            (acc, n) = (acc.union(bins.boxes[b]), n + bins.leave[b]);
+            right[b] = (acc, n);
+        }
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
+        for b in 0..BINS - 1 {
+            (acc, n) = (acc.union(bins.boxes[b]), n + bins.enter[b]);
+            let (right_box, right_n) = right[b + 1];
+            if n == 0 || right_n == 0 {
+                continue;
+            }
+            let cost = C_TRAV + (area(&acc) * n as f32 + area(&right_box) * right_n as f32) / total;
+            if best.as_ref().is_none_or(|s| cost < s.cost) {
+                best = Some(SpatialSplit { axis: slabs.axis, pos: slabs.plane(b + 1), cost, left_n: n, right_n });
+            }
+        }
+    }
+    best
 }
 
 /// [`Aabb::surface_area`] of the box `[lo, hi]`, on 16-byte vectors (the same operations in the same order).
@@ -245,7 +528,7 @@ struct Split {
 
 /// The cheapest binned split over all three centroid axes (axes where the centroids do not spread are
 /// skipped), or `None` when no axis separates them.
-fn best_split(boxes: &[Aabb], centroids: &[Vec3], ids: &[u32], cb: &Aabb, bounds: Aabb) -> Option<Split> {
+fn best_split(refs: &[Ref], cb: &Aabb, bounds: Aabb) -> Option<Split> {
     let extent = cb.extent();
     let scale: [f32; 3] = std::array::from_fn(|a| {
         let s = BINS as f32 / extent[a];
@@ -260,8 +543,8 @@ fn best_split(boxes: &[Aabb], centroids: &[Vec3], ids: &[u32], cb: &Aabb, bounds
     let mut bin_n = [[0u32; BINS]; 3];
     // The three axes' bins at once, with `bin_of`'s arithmetic in each lane (so `partition` agrees).
     let (origin, scale3, last) = (Vec3A::from(cb.min), Vec3A::from_array(scale), UVec3::splat(BINS as u32 - 1));
-    for &i in ids {
-        let (c, b) = (Vec3A::from(centroids[i as usize]), &boxes[i as usize]);
+    for r in refs {
+        let (c, b) = (Vec3A::from(r.centroid()), &r.bounds);
         let (lo, hi) = (Vec3A::from(b.min), Vec3A::from(b.max));
         let bins = ((c - origin) * scale3).as_uvec3().min(last).to_array();
         for (a, &k) in bins.iter().enumerate() {
