@@ -82,8 +82,13 @@ impl Aabb {
         (self.min + self.max) * 0.5
     }
 
-    /// Surface area, the probability measure of the SAH (thesis Eq. 2.1); zero for an empty box.
+    /// Surface area, the probability measure of the SAH (thesis Eq. 2.1); zero for an empty box, also one
+    /// empty along a single axis (such as the intersection of boxes that do not overlap), whose clamped
+    /// extent would otherwise count two of its faces.
     pub fn surface_area(&self) -> f32 {
+        if self.is_empty() {
+            return 0.0;
+        }
         let e = self.extent();
         2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
     }
@@ -145,6 +150,8 @@ mod tests {
         let a = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0));
         assert_eq!(a.surface_area(), 2.0 * (2.0 + 6.0 + 3.0));
         assert_eq!(Aabb::EMPTY.surface_area(), 0.0);
+        let apart = a.intersection(Aabb::new(Vec3::new(5.0, 0.0, 0.0), Vec3::new(6.0, 2.0, 3.0)));
+        assert_eq!(apart.surface_area(), 0.0, "disjoint along x only: {apart:?}");
         let b = Aabb::EMPTY.union(a);
         assert_eq!(a, b);
         assert!(Aabb::EMPTY.is_empty());

@@ -106,7 +106,7 @@ pub fn build(tris: &[[Vec3; 3]], params: &MbvhParams) -> Built {
         Bin::Leaf { bounds: Aabb::EMPTY, ids: Vec::new() }
     } else {
         let extent = Extent::of(&refs);
-        let ctx = Context { tris, root_area: area(&extent.bounds), spatial_min: params.spatial_min_refs };
+        let ctx = Context { tris, root_area: extent.bounds.surface_area(), spatial_min: params.spatial_min_refs };
         let budget = (refs.len() as f64 * params.split_budget.max(1.0) as f64) as usize;
         split(&ctx, refs, extent, 0, budget, &mut count)
     };
@@ -282,7 +282,7 @@ impl Choice {
 fn choose(ctx: &Context, refs: &[Ref], extent: &Extent, budget: usize) -> Option<Choice> {
     let object = best_split(refs, &extent.centroids, extent.bounds);
     let overlapping =
-        object.as_ref().is_none_or(|s| area(&s.left.intersection(s.right)) > SPATIAL_OVERLAP * ctx.root_area);
+        object.as_ref().is_none_or(|s| s.left.intersection(s.right).surface_area() > SPATIAL_OVERLAP * ctx.root_area);
     let spatial = if refs.len() >= ctx.spatial_min && budget > refs.len() && overlapping {
         best_spatial(ctx, refs, &extent.bounds).filter(|s| s.left_n + s.right_n <= budget)
     } else {
@@ -406,11 +406,6 @@ fn leaf_cost(n: usize) -> f32 {
     n.div_ceil(4) as f32 * C_BLOCK
 }
 
-/// Surface area of `b`, zero when it is empty (a box empty on one axis would otherwise count its faces).
-fn area(b: &Aabb) -> f32 {
-    if b.is_empty() { 0.0 } else { b.surface_area() }
-}
-
 /// A spatial split: the plane `coord[axis] = pos`, with the references each side would get.
 struct SpatialSplit {
     axis: usize,
@@ -481,7 +476,7 @@ fn bin_space(ctx: &Context, refs: &[Ref], slabs: &[Option<Slabs>; 3]) -> [Spatia
 /// each reference is cut into every slab it crosses ([`Slabs::chop`]), and counted where it enters and where it
 /// leaves.
 fn best_spatial(ctx: &Context, refs: &[Ref], bounds: &Aabb) -> Option<SpatialSplit> {
-    let total = area(bounds).max(f32::MIN_POSITIVE);
+    let total = bounds.surface_area().max(f32::MIN_POSITIVE);
     let slabs: [Option<Slabs>; 3] = std::array::from_fn(|axis| {
         let lo = coord(&bounds.min, axis);
         let width = (coord(&bounds.max, axis) - lo) / BINS as f32;
@@ -504,7 +499,8 @@ fn best_spatial(ctx: &Context, refs: &[Ref], bounds: &Aabb) -> Option<SpatialSpl
             if n == 0 || right_n == 0 {
                 continue;
             }
-            let cost = C_TRAV + (area(&acc) * leaf_cost(n) + area(&right_box) * leaf_cost(right_n)) / total;
+            let cost =
+                C_TRAV + (acc.surface_area() * leaf_cost(n) + right_box.surface_area() * leaf_cost(right_n)) / total;
             if best.as_ref().is_none_or(|s| cost < s.cost) {
                 best = Some(SpatialSplit { axis: slabs.axis, pos: slabs.plane(b + 1), cost, left_n: n, right_n });
             }
@@ -552,7 +548,7 @@ fn best_split(refs: &[Ref], cb: &Aabb, bounds: Aabb) -> Option<Split> {
     let mut bin_lo = [[Vec3A::INFINITY; BINS]; 3];
     let mut bin_hi = [[Vec3A::NEG_INFINITY; BINS]; 3];
     let mut bin_n = [[0u32; BINS]; 3];
-    // The three axes' bins at once, with `bin_of`'s arithmetic in each lane (so `partition` agrees).
+    // The three axes' bins at once, with `bin_of`'s arithmetic in each lane (so `partition_objects` agrees).
     let (origin, scale3, last) = (Vec3A::from(cb.min), Vec3A::from_array(scale), UVec3::splat(BINS as u32 - 1));
     for r in refs {
         let (c, b) = (Vec3A::from(r.centroid()), &r.bounds);
