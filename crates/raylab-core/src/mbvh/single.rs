@@ -118,60 +118,69 @@ impl<V: Vf32> Leaves for Blocker<'_, V> {
     }
 }
 
-/// One ray's walk through [`raylab_simd::dispatch`]: on AVX2 CPUs the four-wide box and triangle tests are
-/// compiled inside the AVX2 entry point (VEX encodings, SSE4.1's blends inlined); the node and leaf layouts
-/// are four wide, so wider backends run them with SSE's lane type.
-struct SingleRay<'a> {
-    mbvh: &'a Mbvh,
-    ray: &'a Ray,
-    stats: &'a mut TraversalStats,
-    shadow: bool,
+/// What a single-ray walk looks for: its leaves ([`Closest`] or [`Blocker`]) for the lane type the kernel
+/// picked, and what it returns.
+trait Query {
+    type Output;
+    fn walk<V: Vf32>(mbvh: &Mbvh, ray: &Ray, stats: &mut TraversalStats) -> Self::Output;
 }
 
-/// What a [`SingleRay`] walk found: the closest hit, or the first blocker.
-enum Found {
-    Hit(Option<Hit>),
-    Blocker(Option<u32>),
-}
+/// The closest hit.
+struct ClosestHit;
 
-impl Kernel for SingleRay<'_> {
-    type Output = Found;
+impl Query for ClosestHit {
+    type Output = Option<Hit>;
     #[inline(always)]
-    fn run<V: Vf32>(self) -> Found {
-        #[cfg(target_arch = "x86_64")]
-        if V::LANES > 4 {
-            return self.walk::<raylab_simd::sse::F32x4>();
-        }
-        self.walk::<V>()
+    fn walk<V: Vf32>(mbvh: &Mbvh, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        let shear = ShearX4::<V>::new(&RayShear::new(ray));
+        let mut leaves = Closest { mbvh, shear, tmin: ray.tmin, best_t: ray.tmax, best: None, tests: 0 };
+        mbvh.walk_sized::<V>(ray, stats, &mut leaves);
+        stats.isect_tests += leaves.tests;
+        leaves.best
     }
 }
 
-impl SingleRay<'_> {
+/// The first blocker found.
+struct FirstBlocker;
+
+impl Query for FirstBlocker {
+    type Output = Option<u32>;
     #[inline(always)]
-    fn walk<V: Vf32>(self) -> Found {
-        let Self { mbvh, ray, stats, shadow } = self;
+    fn walk<V: Vf32>(mbvh: &Mbvh, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         let shear = ShearX4::<V>::new(&RayShear::new(ray));
-        if shadow {
-            let mut leaves = Blocker { mbvh, shear, tmin: ray.tmin, tmax: ray.tmax, found: None, tests: 0 };
-            mbvh.walk_sized::<V>(ray, stats, &mut leaves);
-            stats.isect_tests += leaves.tests;
-            Found::Blocker(leaves.found)
-        } else {
-            let mut leaves = Closest { mbvh, shear, tmin: ray.tmin, best_t: ray.tmax, best: None, tests: 0 };
-            mbvh.walk_sized::<V>(ray, stats, &mut leaves);
-            stats.isect_tests += leaves.tests;
-            Found::Hit(leaves.best)
+        let mut leaves = Blocker { mbvh, shear, tmin: ray.tmin, tmax: ray.tmax, found: None, tests: 0 };
+        mbvh.walk_sized::<V>(ray, stats, &mut leaves);
+        stats.isect_tests += leaves.tests;
+        leaves.found
+    }
+}
+
+/// One ray's walk through [`raylab_simd::dispatch`]: on AVX2 CPUs the four-wide box and triangle tests are
+/// compiled inside the AVX2 entry point (VEX encodings, SSE4.1's blends inlined); the node and leaf layouts
+/// are four wide, so wider backends run them with SSE's lane type.
+struct SingleRay<'a, Q> {
+    mbvh: &'a Mbvh,
+    ray: &'a Ray,
+    stats: &'a mut TraversalStats,
+    query: std::marker::PhantomData<Q>,
+}
+
+impl<Q: Query> Kernel for SingleRay<'_, Q> {
+    type Output = Q::Output;
+    #[inline(always)]
+    fn run<V: Vf32>(self) -> Q::Output {
+        #[cfg(target_arch = "x86_64")]
+        if V::LANES > 4 {
+            return Q::walk::<raylab_simd::sse::F32x4>(self.mbvh, self.ray, self.stats);
         }
+        Q::walk::<V>(self.mbvh, self.ray, self.stats)
     }
 }
 
 impl Mbvh {
     /// The closest hit along `ray` in `(tmin, tmax]`.
     pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        match self.single_ray(ray, stats, false) {
-            Found::Hit(hit) => hit,
-            Found::Blocker(_) => unreachable!("a closest-hit walk reports a hit"),
-        }
+        self.single_ray::<ClosestHit>(ray, stats)
     }
 
     /// True when anything blocks `ray` in `(tmin, tmax]`.
@@ -181,14 +190,12 @@ impl Mbvh {
 
     /// The first blocker found along `ray` (not necessarily the nearest), for the shadow cache.
     pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
-        match self.single_ray(ray, stats, true) {
-            Found::Blocker(tri) => tri,
-            Found::Hit(_) => unreachable!("an occlusion walk reports a blocker"),
-        }
+        self.single_ray::<FirstBlocker>(ray, stats)
     }
 
-    fn single_ray(&self, ray: &Ray, stats: &mut TraversalStats, shadow: bool) -> Found {
-        raylab_simd::dispatch(self.backend.at_most_eight_lanes(), SingleRay { mbvh: self, ray, stats, shadow })
+    fn single_ray<Q: Query>(&self, ray: &Ray, stats: &mut TraversalStats) -> Q::Output {
+        let kernel = SingleRay::<Q> { mbvh: self, ray, stats, query: std::marker::PhantomData };
+        raylab_simd::dispatch(self.backend.at_most_eight_lanes(), kernel)
     }
 
     /// [`tri4::closest_in_leaf`] on this tree's blocks.
