@@ -17,6 +17,7 @@ use std::ops::Range;
 
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
+use rayon::prelude::*;
 
 use crate::packet::sheared_test;
 use crate::ray::Hit;
@@ -55,7 +56,7 @@ impl Tri4 {
 
 /// Four-triangle blocks of a leaf-ordered soup (padding slots hold NaN triangles).
 pub fn blocks_of(tris: &TriangleSoup) -> Vec<Tri4> {
-    tris.as_slice().chunks(4).map(Tri4::pack).collect()
+    tris.as_slice().par_chunks(4).with_min_len(2048).map(Tri4::pack).collect()
 }
 
 /// Moves each leaf `(first, count)` of `ids` to a slot that is a multiple of four (keeping the leaves'

@@ -8,6 +8,7 @@
 //! of exactly zero are recomputed in double precision, as the paper prescribes.
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 /// Relative slack on the far test made before the division, `t_scaled <= tmax * |det|`. The quotient `t` is
 /// rounded twice and that product once, so without the slack the early test could turn away a hit whose `t`
@@ -134,6 +135,9 @@ pub struct TriangleSoup {
     verts: Vec<[Vec3; 3]>,
 }
 
+/// Triangles per rayon task when [`TriangleSoup::gather`] copies corners on the current pool.
+const GATHER_CHUNK: usize = 8192;
+
 impl TriangleSoup {
     /// Copies the corners of every scene triangle.
     pub fn from_scene(scene: &Scene) -> Self {
@@ -145,7 +149,8 @@ impl TriangleSoup {
     pub fn gather(scene: &Scene, ids: &[u32]) -> Self {
         let n = scene.triangle_count();
         let pad = [Vec3::NAN; 3];
-        Self { verts: ids.iter().map(|&i| if (i as usize) < n { scene.vertices(i as usize) } else { pad }).collect() }
+        let corners = |&i: &u32| if (i as usize) < n { scene.vertices(i as usize) } else { pad };
+        Self { verts: ids.par_iter().with_min_len(GATHER_CHUNK).map(corners).collect() }
     }
 
     /// The corners of triangle `i`.

@@ -100,11 +100,14 @@ impl Mbvh {
         let start = Instant::now();
         let corners: Vec<[Vec3; 3]> = (0..scene.triangle_count()).map(|i| scene.vertices(i)).collect();
         let built = build::build(&corners, params);
-        let depth = depth_of(&built.nodes);
         let tris = TriangleSoup::gather(scene, &built.tri_ids);
+        let ((blocks, slot_of), depth) = rayon::join(
+            || rayon::join(|| blocks_of(&tris), || inverse(&built.tri_ids, scene.triangle_count())),
+            || depth_of(&built.nodes),
+        );
         Self {
-            blocks: blocks_of(&tris),
-            slot_of: inverse(&built.tri_ids, scene.triangle_count()),
+            blocks,
+            slot_of,
             nodes: built.nodes,
             tri_ids: built.tri_ids,
             bounds: scene.bounds(),
