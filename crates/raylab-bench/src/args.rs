@@ -3,6 +3,7 @@
 use clap::Args;
 use glam::Vec3;
 use raylab_core::kdtree::KdParams;
+use raylab_core::method::Method;
 use raylab_core::render::RenderSettings;
 use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::shadow::{SampleBound, ShadowKind, Shadows};
@@ -181,12 +182,13 @@ impl ImageArgs {
     }
 }
 
-/// kd-tree cost-model flags (thesis Eq. 2.1); the defaults are [`KdParams::default`].
+/// kd-tree cost-model flags (thesis Eq. 2.1); the defaults are [`KdParams::for_method`]'s.
 #[derive(Args, Clone, Debug)]
 pub struct KdArgs {
-    /// Traversal cost C_traversal of the SAH.
-    #[arg(long, default_value_t = KdParams::default().c_trav, allow_hyphen_values = true)]
-    pub kd_ctrav: f32,
+    /// Traversal cost C_traversal of the SAH [default: 12 for the trees of frustum, mft, cone and mft-cone,
+    /// whose leaf visits cost more than their node steps; 1, the thesis's, for every other method].
+    #[arg(long, allow_hyphen_values = true)]
+    pub kd_ctrav: Option<f32>,
     /// Intersection cost C_intersect of the SAH (the thesis uses 5 x C_traversal).
     #[arg(long, default_value_t = KdParams::default().c_isect, allow_hyphen_values = true)]
     pub kd_cisect: f32,
@@ -199,14 +201,21 @@ pub struct KdArgs {
 }
 
 impl KdArgs {
-    /// The parameters, checked; the error names the flag.
+    /// The parameters of the thesis's tree (the one that single rays, packets and the thesis's tables
+    /// use), with the flags' changes; checked, and the error names the flag.
     pub fn params(&self) -> Result<KdParams, String> {
+        self.params_for(Method::Mono)
+    }
+
+    /// The parameters of the tree that `method` walks ([`KdParams::for_method`]), with the flags' changes;
+    /// checked, and the error names the flag.
+    pub fn params_for(&self, method: Method) -> Result<KdParams, String> {
         let p = KdParams {
-            c_trav: self.kd_ctrav,
+            c_trav: self.kd_ctrav.unwrap_or(KdParams::for_method(method).c_trav),
             c_isect: self.kd_cisect,
             empty_bonus: self.kd_empty_bonus,
             max_depth: self.kd_max_depth.map(|d| d as u32),
-            ..KdParams::default()
+            ..KdParams::for_method(method)
         };
         p.validate().map_err(|m| format!("--kd-*: {m}"))?;
         Ok(p)

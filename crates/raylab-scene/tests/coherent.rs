@@ -56,16 +56,27 @@ fn same_hit(got: Option<Hit>, want: Option<Hit>) -> bool {
     }
 }
 
-/// Compares every method against mono on the primary and shadow rays of one view.
+/// Compares every method against mono on the primary and shadow rays of one view: on mono's tree (the
+/// thesis's cost model), and the bundle methods also on the tree built for them
+/// ([`KdParams::for_method`]), whose leaves are larger.
 fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what: &str) {
     let tree = KdTree::build(scene, &KdParams::default()).unwrap();
+    let bundle_tree = KdTree::build(scene, &KdParams::for_method(Method::Mft)).unwrap();
+    if scene.triangles.len() > 1000 {
+        // Otherwise the second tree would test nothing new.
+        assert!(bundle_tree.nodes().len() < tree.nodes().len(), "{what}: the bundle methods' tree is not coarser");
+    }
     let wb = WorkloadBuilder::new(scene, cam, light, w as u32, h as u32, &tree);
     let primary = wb.build(RayKind::Primary).rays;
     let shadow = wb.build(RayKind::Shadow).rays;
     let mono = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
     let (want_hits, _) = trace_image(&mono, &primary, w, h, 8, None);
     let (_, want_occ) = trace_image(&mono, &shadow, w, h, 8, Some(light));
-    for method in METHODS {
+    let walks = METHODS.into_iter().flat_map(|m| {
+        let own = m.is_bundled().then_some((m, &bundle_tree, "own tree"));
+        [Some((m, &tree, "mono's tree")), own].into_iter().flatten()
+    });
+    for (method, walked, which) in walks {
         for backend in Backend::available() {
             for (cull, spread) in
                 [(true, TraceOptions::SHADOW_SPREAD_LIMIT), (false, f32::INFINITY), (true, f32::INFINITY)]
@@ -74,19 +85,19 @@ fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what
                     // An infinite spread limit sends every shadow tile down the frustum path.
                     let opts =
                         TraceOptions { method, cull, backend, shadow_spread_limit: spread, ..TraceOptions::default() };
-                    let tracer = Tracer::new(&tree, None, opts);
+                    let tracer = Tracer::new(walked, None, opts);
                     let (hits, _) = trace_image(&tracer, &primary, w, h, tile, None);
                     let (_, occ) = trace_image(&tracer, &shadow, w, h, tile, Some(light));
                     for i in 0..w * h {
                         if primary[i].is_some() {
                             assert!(
                                 same_hit(hits[i], want_hits[i]),
-                                "{what}: {opts:?} tile {tile} pixel {i}: {:?} vs mono {:?}",
+                                "{what}: {opts:?} on {which}, tile {tile} pixel {i}: {:?} vs mono {:?}",
                                 hits[i],
                                 want_hits[i]
                             );
                         }
-                        assert_eq!(occ[i], want_occ[i], "{what}: {opts:?} tile {tile} shadow pixel {i}");
+                        assert_eq!(occ[i], want_occ[i], "{what}: {opts:?} on {which}, tile {tile} shadow pixel {i}");
                     }
                 }
             }

@@ -46,7 +46,8 @@ fn main() -> ExitCode {
 
 fn run(cli: &Cli) -> Result<(), String> {
     cli.validate()?;
-    let kd = cli.kd.params()?;
+    // The tree's cost model is the starting method's (`KdParams::for_method`): the bundle methods' for MFT.
+    let kd = cli.kd.params_for(cli.method.method)?;
     let scene = with_spinner("loading scene and building the kd-tree", || loader::load_now(&cli.scene, &kd, &|_| {}))?;
     let settings = ViewerSettings {
         mode: cli.mode,

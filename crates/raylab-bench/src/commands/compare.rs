@@ -164,20 +164,27 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let mut embree = EmbreeRun::default();
     embree.merge(with_spinner("Embree harness: builds", || run_embree(a, &cam, light.position, "none", a.builds))?);
 
-    let params = a.kd.params()?;
+    // The thesis's tree for single rays and packets, and the one with the bundle methods' cost model
+    // (`KdParams::for_method`) for frustums, MFT and cones.
+    let params = [a.kd.params()?, a.kd.params_for(Method::Mft)?];
     let mut builds = Vec::new();
-    let mut tree: Option<KdTree> = None;
+    let mut trees: [Option<KdTree>; 2] = [None, None];
     for &t in &a.threads {
-        let mut times = Vec::new();
+        let mut times = [Vec::new(), Vec::new()];
         for _ in 0..a.builds {
-            let built = build_tree(&scene, &params, t as usize)?;
-            times.push(built.build_time().as_secs_f64());
-            tree = Some(built);
+            for (k, p) in params.iter().enumerate() {
+                let built = build_tree(&scene, p, t as usize)?;
+                times[k].push(built.build_time().as_secs_f64());
+                trees[k] = Some(built);
+            }
         }
-        times.sort_by(f64::total_cmp);
-        builds.push((t, times[times.len() / 2]));
+        let [thesis, bundles] = times.map(|mut v| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        });
+        builds.push((t, thesis, bundles));
     }
-    let tree = tree.ok_or("--threads: no thread count given")?;
+    let [Some(tree), Some(bundle_tree)] = trees else { return Err("--threads: no thread count given".into()) };
     let reference = BruteForce::new(&scene);
     let (w, h) = a.image.size();
     let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree));
@@ -212,7 +219,8 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             let tiles: Vec<u64> = if method.uses_tiles() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
             for &tile in &tiles {
                 for &t in &a.threads {
-                    let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
+                    let walked = if method.is_bundled() { &bundle_tree } else { &tree };
+                    let tracer = Tracer::new(walked, None, TraceOptions { method, ..Default::default() });
                     let (report, results) = measure(
                         &tracer,
                         &workload,
@@ -268,11 +276,15 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             r.isects_per_ray
         );
     }
-    let _ = writeln!(md, "\n| build | threads | raylab kd-tree (SAH, perfect splits) s | Embree BVH (HIGH) s |");
-    let _ = writeln!(md, "|---|---:|---:|---:|");
-    for (t, s) in &builds {
+    let _ = writeln!(
+        md,
+        "\n| build | threads | raylab kd-tree (SAH, perfect splits, C_trav {}) s | the bundle methods' kd-tree (C_trav {}) s | Embree BVH (HIGH) s |",
+        params[0].c_trav, params[1].c_trav
+    );
+    let _ = writeln!(md, "|---|---:|---:|---:|---:|");
+    for (t, thesis, bundles) in &builds {
         let e = embree.builds.iter().find(|(et, _)| et == t).map_or("n/a".into(), |(_, s)| format!("{s:.3}"));
-        let _ = writeln!(md, "| median of {} | {} | {:.3} | {} |", a.builds, t, s, e);
+        let _ = writeln!(md, "| median of {} | {} | {:.3} | {:.3} | {} |", a.builds, t, thesis, bundles, e);
     }
     if !coherent.is_empty() {
         let backend = TraceOptions::default().backend;
@@ -282,8 +294,10 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             md,
             "\nCoherent methods against Embree's best packet or stream API for the same rays and thread count \
              ({} backend; N = nodes per {packet} packet, I = triangle tests per {packet} packet, culled = \
-             packet/leaf visits culled):\n",
-            backend.name()
+             packet/leaf visits culled; packets walk the thesis's kd-tree, the bundle methods their own, with \
+             C_trav {}):\n",
+            backend.name(),
+            params[1].c_trav
         );
         let _ = writeln!(
             md,

@@ -67,7 +67,7 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         heat_max: a.heat_max,
     };
     let Still { scene, tree, frame, load_s, render_s } =
-        render_still(&a.scene, &a.kd.params()?, a.m.options(), settings, threads)?;
+        render_still(&a.scene, &a.kd.params_for(a.m.method)?, a.m.options(), settings, threads)?;
     let img = image::RgbaImage::from_raw(frame.width, frame.height, frame.rgba.as_flattened().to_vec())
         .ok_or("frame buffer size mismatch")?;
     img.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;

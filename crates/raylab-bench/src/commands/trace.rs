@@ -56,7 +56,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     let env = Environment::detect();
     let (scene, _) = load_scene(&a.scene.source())?;
     let (camera, light) = a.scene.camera_and_light(&scene)?;
-    let tree = build_tree(&scene, &a.kd.params()?, a.threads as usize)?;
+    let tree = build_tree(&scene, &a.kd.params_for(a.m.method)?, a.threads as usize)?;
     let reference = BruteForce::new(&scene);
     let (w, h) = a.image.size();
     let builder = with_spinner("generating rays", || {
