@@ -52,7 +52,7 @@ impl AnimatedScene {
     /// Adds the moving objects to `source`'s scene and builds its structures.
     pub fn new(source: &Arc<LoadedScene>) -> Result<Self, String> {
         let (scene, anim) = Animation::add_movers(&source.scene);
-        let tree = KdTree::build(&scene, source.tree.params()).map_err(|e| format!("animation: kd-tree: {e}"))?;
+        let tree = KdTree::build(&scene, &source.params.thesis).map_err(|e| format!("animation: kd-tree: {e}"))?;
         let mbvh = Mbvh::build(&scene);
         let dacrt = Dacrt::new(&scene);
         Ok(Self { source: Arc::clone(source), anim, start: Instant::now(), scene, tree, mbvh, dacrt })
@@ -77,8 +77,9 @@ impl AnimatedScene {
         let method = settings.frame_method();
         if needs_kd_tree(settings) {
             let t = Instant::now();
-            self.tree =
-                KdTree::build(&self.scene, self.tree.params()).map_err(|e| format!("animation: kd-tree: {e}"))?;
+            // The tree of the frame's method ([`crate::loader::TreeParams`]).
+            let params = self.source.params.for_method(method);
+            self.tree = KdTree::build(&self.scene, params).map_err(|e| format!("animation: kd-tree: {e}"))?;
             out.kd_rebuild_ms = Some(ms(t));
         }
         if method.uses_mbvh() {

@@ -7,18 +7,57 @@ use std::time::{Duration, Instant};
 
 use raylab_bench::args::SceneArgs;
 use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::{KdParams, KdStats, KdTree};
+use raylab_core::kdtree::{KdBuildError, KdParams, KdStats, KdTree};
 use raylab_core::mbvh::Mbvh;
+use raylab_core::method::Method;
 use raylab_core::scene::{Camera, PointLight, Scene};
 
-/// A scene ready to trace: the triangles, their kd-tree, and the view and light it opened with.
+/// The kd-tree cost models a scene's trees are built with: one for single rays and packets (the thesis's)
+/// and one for the bundle methods ([`KdParams::for_method`]), each with the command line's changes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeParams {
+    /// The tree of mono, packets and the shadows and reflections they trace.
+    pub thesis: KdParams,
+    /// The tree of frustum, MFT, cone and MFT over cones.
+    pub bundles: KdParams,
+}
+
+impl TreeParams {
+    /// The parameters of the tree that `method` walks.
+    pub fn for_method(&self, method: Method) -> &KdParams {
+        if method.is_bundled() { &self.bundles } else { &self.thesis }
+    }
+}
+
+/// A built kd-tree and what the panel shows of it.
+pub struct BuiltTree {
+    /// The tree.
+    pub tree: KdTree,
+    /// Seconds its build took.
+    pub build_s: f64,
+    /// Its size and quality.
+    pub stats: KdStats,
+}
+
+impl BuiltTree {
+    fn build(scene: &Scene, params: &KdParams) -> Result<Self, KdBuildError> {
+        let tree = KdTree::build(scene, params)?;
+        Ok(Self { build_s: tree.build_time().as_secs_f64(), stats: tree.stats(), tree })
+    }
+}
+
+/// A scene ready to trace: the triangles, their kd-trees, and the view and light it opened with.
 pub struct LoadedScene {
     /// Name shown in the panel: the built-in name or the file name.
     pub name: String,
     /// The scene.
     pub scene: Scene,
-    /// Its kd-tree.
-    pub tree: KdTree,
+    /// Its kd-tree for single rays and packets.
+    pub kd: BuiltTree,
+    /// Its kd-tree for the bundle methods, when their parameters differ.
+    pub bundle_kd: Option<BuiltTree>,
+    /// The parameters of both trees (the animation rebuilds with them).
+    pub params: TreeParams,
     /// Its 4-wide BVH, for the mbvh method.
     pub mbvh: Mbvh,
     /// Its triangles prepared for divide-and-conquer tracing (a copy, no structure), for the dacrt method.
@@ -29,16 +68,22 @@ pub struct LoadedScene {
     pub light: PointLight,
     /// Seconds spent loading and building.
     pub load_s: f64,
-    /// Seconds spent building the kd-tree.
-    pub build_s: f64,
-    /// Size and quality of the tree.
-    pub kd_stats: KdStats,
     /// What the loader worked around (missing textures and the like), each naming the file.
     pub warnings: Vec<String>,
 }
 
-/// Loads `args`' scene and builds its tree on the calling thread, reporting the stage through `stage`.
-pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Result<LoadedScene, String> {
+impl LoadedScene {
+    /// The kd-tree that `method` walks, and what the panel shows of it.
+    pub fn kd_for(&self, method: Method) -> &BuiltTree {
+        match &self.bundle_kd {
+            Some(b) if method.is_bundled() => b,
+            _ => &self.kd,
+        }
+    }
+}
+
+/// Loads `args`' scene and builds its trees on the calling thread, reporting the stage through `stage`.
+pub fn load_now(args: &SceneArgs, params: &TreeParams, stage: &dyn Fn(&str)) -> Result<LoadedScene, String> {
     let t0 = Instant::now();
     stage("loading scene");
     let progress = |done: f32| stage(&format!("loading scene {:.0}%", done * 100.0));
@@ -46,7 +91,13 @@ pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Re
         raylab_scene::load_with_progress(&args.source(), &progress).map_err(|e| e.to_string())?;
     let (camera, light) = args.camera_and_light(&scene)?;
     stage("building kd-tree");
-    let tree = KdTree::build(&scene, params).map_err(|e| format!("{}: {e}", args.scene))?;
+    let kd = BuiltTree::build(&scene, &params.thesis).map_err(|e| format!("{}: {e}", args.scene))?;
+    let bundle_kd = if params.bundles == params.thesis {
+        None
+    } else {
+        stage("building the bundle methods' kd-tree");
+        Some(BuiltTree::build(&scene, &params.bundles).map_err(|e| format!("{}: {e}", args.scene))?)
+    };
     stage("building MBVH");
     let mbvh = Mbvh::build(&scene);
     let dacrt = Dacrt::new(&scene);
@@ -55,10 +106,10 @@ pub fn load_now(args: &SceneArgs, params: &KdParams, stage: &dyn Fn(&str)) -> Re
         .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
     Ok(LoadedScene {
         name,
-        build_s: tree.build_time().as_secs_f64(),
-        kd_stats: tree.stats(),
         scene,
-        tree,
+        kd,
+        bundle_kd,
+        params: *params,
         mbvh,
         dacrt,
         camera,
@@ -87,7 +138,7 @@ pub enum LoadPoll {
 
 impl PendingLoad {
     /// Starts loading `args` with `params` on a new thread; `wake` is called when it finishes.
-    pub fn start(args: SceneArgs, params: KdParams, wake: impl Fn() + Send + 'static) -> Self {
+    pub fn start(args: SceneArgs, params: TreeParams, wake: impl Fn() + Send + 'static) -> Self {
         let stage = Arc::new(Mutex::new(String::from("starting")));
         let (tx, done) = mpsc::channel();
         let what = args.scene.clone();

@@ -27,6 +27,7 @@ use std::sync::Arc;
 
 use clap::Parser;
 use raylab_bench::prepare::with_spinner;
+use raylab_core::method::Method;
 
 use crate::camera_path::CameraPath;
 use crate::cli::Cli;
@@ -46,8 +47,8 @@ fn main() -> ExitCode {
 
 fn run(cli: &Cli) -> Result<(), String> {
     cli.validate()?;
-    // The tree's cost model is the starting method's (`KdParams::for_method`): the bundle methods' for MFT.
-    let kd = cli.kd.params_for(cli.method.method)?;
+    // Two trees when their cost models differ (`KdParams::for_method`): each method walks its own.
+    let kd = loader::TreeParams { thesis: cli.kd.params()?, bundles: cli.kd.params_for(Method::Mft)? };
     let scene = with_spinner("loading scene and building the kd-tree", || loader::load_now(&cli.scene, &kd, &|_| {}))?;
     let settings = ViewerSettings {
         mode: cli.mode,

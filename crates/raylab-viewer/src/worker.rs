@@ -112,9 +112,10 @@ pub struct Structures<'a> {
 }
 
 impl LoadedScene {
-    /// The loaded scene's structures.
-    pub fn structures(&self) -> Structures<'_> {
-        Structures { scene: &self.scene, tree: &self.tree, mbvh: &self.mbvh, dacrt: &self.dacrt }
+    /// The loaded scene's structures for frames traced with `method` (its kd-tree is the method's,
+    /// [`LoadedScene::kd_for`]).
+    pub fn structures(&self, method: Method) -> Structures<'_> {
+        Structures { scene: &self.scene, tree: &self.kd_for(method).tree, mbvh: &self.mbvh, dacrt: &self.dacrt }
     }
 }
 
@@ -338,7 +339,8 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
                     progressive = Some(Progressive { job: job.clone(), acc, passes: 0 });
                 }
                 let Some(p) = progressive.as_mut() else { continue };
-                let s = moving.map_or_else(|| job.scene.structures(), AnimatedScene::structures);
+                let s =
+                    moving.map_or_else(|| job.scene.structures(job.settings.frame_method()), AnimatedScene::structures);
                 let mut rendered = pool.install(|| distribution_pass(p, &s));
                 rendered.animation = update;
                 // Keep refining while the view stays, up to the pass limit.
@@ -348,7 +350,8 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
                 send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
             }
             Task::Frame(job) => {
-                let s = moving.map_or_else(|| job.scene.structures(), AnimatedScene::structures);
+                let s =
+                    moving.map_or_else(|| job.scene.structures(job.settings.frame_method()), AnimatedScene::structures);
                 let mut rendered = pool.install(|| trace_in(&s, &job, job.settings.trace.method));
                 rendered.animation = update;
                 shared.lock().repeat = (job.settings.continuous || job.settings.animate).then(|| job.clone());
@@ -377,7 +380,7 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
                 }
                 let s = match (&animated, update) {
                     (Some(a), Some(_)) => a.structures(),
-                    _ => r.job.scene.structures(),
+                    _ => r.job.scene.structures(r.job.settings.frame_method()),
                 };
                 let mut rendered = pool.install(|| reflections(&r, &s, &mut rbuffer));
                 rendered.animation = update;
@@ -479,7 +482,7 @@ fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rend
 
 /// Traces `job` with `method` on the current rayon pool, in the loaded scene.
 pub fn trace_frame(job: &Job, method: Method) -> Rendered {
-    trace_in(&job.scene.structures(), job, method)
+    trace_in(&job.scene.structures(method), job, method)
 }
 
 /// Traces `job` with `method` in the scene and structures `s`.

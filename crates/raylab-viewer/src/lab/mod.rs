@@ -11,12 +11,11 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use raylab_bench::args::SceneArgs;
-use raylab_core::kdtree::KdParams;
 use raylab_core::scene::PointLight;
 
 use crate::camera_path::{CameraPath, Player, Recorder};
 use crate::fly::{FlyCamera, MoveKeys};
-use crate::loader::{LoadPoll, LoadedScene, PendingLoad};
+use crate::loader::{LoadPoll, LoadedScene, PendingLoad, TreeParams};
 use crate::settings::{RenderMode, ViewerSettings};
 use crate::worker::{Job, ReflectionJob, Rendered, Worker, WorkerEvent};
 pub use bookmarks::Bookmarks;
@@ -49,7 +48,7 @@ pub enum Shot {
 /// The viewer's state.
 pub struct Lab {
     scene: Arc<LoadedScene>,
-    kd: KdParams,
+    kd: TreeParams,
     /// The settings the next frame is traced with.
     pub settings: ViewerSettings,
     fly: FlyCamera,
@@ -106,7 +105,12 @@ fn is_scene_file(p: &std::path::Path) -> bool {
 
 impl Lab {
     /// A lab showing `scene`; `wake` is called from other threads when a frame or a load is ready.
-    pub fn new(scene: LoadedScene, kd: KdParams, settings: ViewerSettings, wake: Arc<dyn Fn() + Send + Sync>) -> Self {
+    pub fn new(
+        scene: LoadedScene,
+        kd: TreeParams,
+        settings: ViewerSettings,
+        wake: Arc<dyn Fn() + Send + Sync>,
+    ) -> Self {
         let w = Arc::clone(&wake);
         let worker = Worker::start(move || w());
         let fly = FlyCamera::new(scene.camera, &scene.scene.bounds());
@@ -382,13 +386,14 @@ impl Lab {
             self.loading = None;
             match *result {
                 Ok(s) => {
+                    let kd_s = s.kd.build_s + s.bundle_kd.as_ref().map_or(0.0, |b| b.build_s);
                     self.message(
                         format!(
-                            "loaded {}: {} triangles in {:.2} s (kd-tree {:.2} s)",
+                            "loaded {}: {} triangles in {:.2} s (kd-trees {:.2} s)",
                             s.name,
                             s.scene.triangle_count(),
                             s.load_s,
-                            s.build_s
+                            kd_s
                         ),
                         false,
                     );
@@ -558,6 +563,7 @@ impl Lab {
 mod tests {
     use std::time::Duration;
 
+    use raylab_core::kdtree::KdParams;
     use raylab_core::method::Method;
     use raylab_core::render::{FrameView, RayOrder};
     use raylab_core::trace::TraceOptions;
@@ -569,7 +575,7 @@ mod tests {
     use crate::settings::{DistributionControls, RenderMode};
 
     fn lab(method: Method) -> Lab {
-        let kd = KdParams::default();
+        let kd = TreeParams { thesis: KdParams::for_method(Method::Mono), bundles: KdParams::for_method(Method::Mft) };
         let scene = load_now(&SceneArgs::named("arena"), &kd, &|_| {}).unwrap();
         let settings = ViewerSettings {
             mode: RenderMode::Whitted,
@@ -666,6 +672,29 @@ mod tests {
         assert_eq!(md.lines().count(), want.len() + 2);
         assert!(md.lines().any(|line| line.starts_with("| mft | 64x64 |")), "{md}");
         run_ui(&mut l);
+    }
+
+    /// Frustum methods walk the tree built for them, single rays and packets the thesis's, and the pixels
+    /// are the same either way.
+    #[test]
+    fn each_method_walks_its_own_kd_tree() {
+        let mut l = lab(Method::Mft);
+        l.set_window_size(40, 24);
+        let s = l.scene();
+        let (thesis, bundles) = (s.kd_for(Method::Mono), s.kd_for(Method::Mft));
+        assert_eq!(thesis.tree.params().c_trav, KdParams::for_method(Method::Mono).c_trav);
+        assert_eq!(bundles.tree.params().c_trav, KdParams::BUNDLE_C_TRAV);
+        assert!(bundles.stats.nodes < thesis.stats.nodes, "{} vs {} nodes", bundles.stats.nodes, thesis.stats.nodes);
+        assert!(std::ptr::eq(s.kd_for(Method::Packet), thesis) && std::ptr::eq(s.kd_for(Method::Cone), bundles));
+        let job = l.job();
+        let frames: Vec<_> = [Method::Mono, Method::Packet, Method::Mft, Method::Frustum]
+            .into_iter()
+            .map(|m| crate::worker::trace_frame(&job, m).frame)
+            .collect();
+        for f in &frames[1..] {
+            assert!(f.stats.rays > 0);
+            assert_eq!(f.rgba, frames[0].rgba);
+        }
     }
 
     #[test]

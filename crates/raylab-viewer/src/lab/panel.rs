@@ -66,12 +66,14 @@ fn scene_section(lab: &mut Lab, ui: &mut egui::Ui) {
         });
         ui.small("or drop an .obj, .gltf or .glb file on the window");
         let s = &lab.scene;
+        let kd = s.kd_for(lab.settings.frame_method());
         ui.label(format!(
-            "{} triangles, {} kd nodes (depth {}), built in {:.2} s",
+            "{} triangles; the method's kd-tree: {} nodes (depth {}, C_trav {}), built in {:.2} s",
             s.scene.triangle_count(),
-            s.kd_stats.nodes,
-            s.kd_stats.max_depth,
-            s.build_s
+            kd.stats.nodes,
+            kd.stats.max_depth,
+            kd.tree.params().c_trav,
+            kd.build_s
         ));
         let dropped = s.scene.dropped.total();
         if dropped > 0 {
