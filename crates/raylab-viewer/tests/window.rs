@@ -76,7 +76,8 @@ fn run_viewer(dir: &Path, name: &str, headless: bool, args: &[&str]) -> (image::
     (img, json)
 }
 
-/// The `raylab-bench render` image of the same view.
+/// The `raylab-bench render` image of the same view, on the kd-tree that `method` walks in both (heat maps
+/// of nodes and tests depend on the tree).
 fn reference(method: Method, shadows: ShadowKind, show: FrameView) -> image::RgbaImage {
     let settings = |light: &PointLight| RenderSettings {
         width: W,
@@ -89,7 +90,8 @@ fn reference(method: Method, shadows: ShadowKind, show: FrameView) -> image::Rgb
         heat_max: None,
     };
     let options = TraceOptions { method, ..TraceOptions::default() };
-    render_still(&SceneArgs::named("atrium"), &KdParams::default(), options, settings, 2).unwrap().image().unwrap()
+    let kd = KdParams::for_method(method);
+    render_still(&SceneArgs::named("atrium"), &kd, options, settings, 2).unwrap().image().unwrap()
 }
 
 fn rect(v: &serde_json::Value) -> [f32; 4] {
