@@ -185,8 +185,8 @@ impl ImageArgs {
 /// kd-tree cost-model flags (thesis Eq. 2.1); the defaults are [`KdParams::for_method`]'s.
 #[derive(Args, Clone, Debug)]
 pub struct KdArgs {
-    /// Traversal cost C_traversal of the SAH [default: 12 for the trees of frustum, mft, cone and mft-cone,
-    /// whose leaf visits cost more than their node steps; 1, the thesis's, for every other method].
+    /// Traversal cost C_traversal of the SAH [default: 12 for the trees of packet, frustum, mft, cone and
+    /// mft-cone, whose leaf visits cost more than their node steps; 1, the thesis's, for every other method].
     #[arg(long, allow_hyphen_values = true)]
     pub kd_ctrav: Option<f32>,
     /// Intersection cost C_intersect of the SAH (the thesis uses 5 x C_traversal).
@@ -201,8 +201,8 @@ pub struct KdArgs {
 }
 
 impl KdArgs {
-    /// The parameters of the thesis's tree (the one that single rays, packets and the thesis's tables
-    /// use), with the flags' changes; checked, and the error names the flag.
+    /// The parameters of the thesis's tree (the one that single rays and the thesis's tables use), with
+    /// the flags' changes; checked, and the error names the flag.
     pub fn params(&self) -> Result<KdParams, String> {
         self.params_for(Method::Mono)
     }

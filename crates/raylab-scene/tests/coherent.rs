@@ -57,14 +57,14 @@ fn same_hit(got: Option<Hit>, want: Option<Hit>) -> bool {
 }
 
 /// Compares every method against mono on the primary and shadow rays of one view: on mono's tree (the
-/// thesis's cost model), and the bundle methods also on the tree built for them
-/// ([`KdParams::for_method`]), whose leaves are larger.
+/// thesis's cost model), and also on the tree built for the packet methods ([`KdParams::for_method`]),
+/// whose leaves are larger.
 fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what: &str) {
     let tree = KdTree::build(scene, &KdParams::default()).unwrap();
-    let bundle_tree = KdTree::build(scene, &KdParams::for_method(Method::Mft)).unwrap();
+    let packet_tree = KdTree::build(scene, &KdParams::for_method(Method::Mft)).unwrap();
     if scene.triangles.len() > 1000 {
         // Otherwise the second tree would test nothing new.
-        assert!(bundle_tree.nodes().len() < tree.nodes().len(), "{what}: the bundle methods' tree is not coarser");
+        assert!(packet_tree.nodes().len() < tree.nodes().len(), "{what}: the packet methods' tree is not coarser");
     }
     let wb = WorkloadBuilder::new(scene, cam, light, w as u32, h as u32, &tree);
     let primary = wb.build(RayKind::Primary).rays;
@@ -73,7 +73,7 @@ fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what
     let (want_hits, _) = trace_image(&mono, &primary, w, h, 8, None);
     let (_, want_occ) = trace_image(&mono, &shadow, w, h, 8, Some(light));
     let walks = METHODS.into_iter().flat_map(|m| {
-        let own = m.is_bundled().then_some((m, &bundle_tree, "own tree"));
+        let own = m.uses_packets().then_some((m, &packet_tree, "own tree"));
         [Some((m, &tree, "mono's tree")), own].into_iter().flatten()
     });
     for (method, walked, which) in walks {

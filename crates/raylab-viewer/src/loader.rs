@@ -13,19 +13,20 @@ use raylab_core::method::Method;
 use raylab_core::scene::{Camera, PointLight, Scene};
 
 /// The kd-tree cost models a scene's trees are built with: one for single rays and packets (the thesis's)
-/// and one for the bundle methods ([`KdParams::for_method`]), each with the command line's changes.
+/// and one for the packet methods ([`KdParams::for_method`]), each with the command line's changes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TreeParams {
-    /// The tree of mono, packets and the shadows and reflections they trace.
+    /// The tree of single rays (mono, and the MBVH and DACRT methods' kd-tree walks: edge-width and
+    /// sampled shadows).
     pub thesis: KdParams,
-    /// The tree of frustum, MFT, cone and MFT over cones.
-    pub bundles: KdParams,
+    /// The tree of packets, frustum, MFT, cone and MFT over cones.
+    pub packets: KdParams,
 }
 
 impl TreeParams {
     /// The parameters of the tree that `method` walks.
     pub fn for_method(&self, method: Method) -> &KdParams {
-        if method.is_bundled() { &self.bundles } else { &self.thesis }
+        if method.uses_packets() { &self.packets } else { &self.thesis }
     }
 }
 
@@ -54,8 +55,8 @@ pub struct LoadedScene {
     pub scene: Scene,
     /// Its kd-tree for single rays and packets.
     pub kd: BuiltTree,
-    /// Its kd-tree for the bundle methods, when their parameters differ.
-    pub bundle_kd: Option<BuiltTree>,
+    /// Its kd-tree for the packet methods, when their parameters differ.
+    pub packet_kd: Option<BuiltTree>,
     /// The parameters of both trees (the animation rebuilds with them).
     pub params: TreeParams,
     /// Its 4-wide BVH, for the mbvh method.
@@ -75,8 +76,8 @@ pub struct LoadedScene {
 impl LoadedScene {
     /// The kd-tree that `method` walks, and what the panel shows of it.
     pub fn kd_for(&self, method: Method) -> &BuiltTree {
-        match &self.bundle_kd {
-            Some(b) if method.is_bundled() => b,
+        match &self.packet_kd {
+            Some(b) if method.uses_packets() => b,
             _ => &self.kd,
         }
     }
@@ -92,11 +93,11 @@ pub fn load_now(args: &SceneArgs, params: &TreeParams, stage: &dyn Fn(&str)) -> 
     let (camera, light) = args.camera_and_light(&scene)?;
     stage("building kd-tree");
     let kd = BuiltTree::build(&scene, &params.thesis).map_err(|e| format!("{}: {e}", args.scene))?;
-    let bundle_kd = if params.bundles == params.thesis {
+    let packet_kd = if params.packets == params.thesis {
         None
     } else {
-        stage("building the bundle methods' kd-tree");
-        Some(BuiltTree::build(&scene, &params.bundles).map_err(|e| format!("{}: {e}", args.scene))?)
+        stage("building the packet methods' kd-tree");
+        Some(BuiltTree::build(&scene, &params.packets).map_err(|e| format!("{}: {e}", args.scene))?)
     };
     stage("building MBVH");
     let mbvh = Mbvh::build(&scene);
@@ -108,7 +109,7 @@ pub fn load_now(args: &SceneArgs, params: &TreeParams, stage: &dyn Fn(&str)) -> 
         name,
         scene,
         kd,
-        bundle_kd,
+        packet_kd,
         params: *params,
         mbvh,
         dacrt,

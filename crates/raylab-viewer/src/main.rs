@@ -48,7 +48,7 @@ fn main() -> ExitCode {
 fn run(cli: &Cli) -> Result<(), String> {
     cli.validate()?;
     // Two trees when their cost models differ (`KdParams::for_method`): each method walks its own.
-    let kd = loader::TreeParams { thesis: cli.kd.params()?, bundles: cli.kd.params_for(Method::Mft)? };
+    let kd = loader::TreeParams { thesis: cli.kd.params()?, packets: cli.kd.params_for(Method::Mft)? };
     let scene = with_spinner("loading scene and building the kd-tree", || loader::load_now(&cli.scene, &kd, &|_| {}))?;
     let settings = ViewerSettings {
         mode: cli.mode,

@@ -164,8 +164,8 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let mut embree = EmbreeRun::default();
     embree.merge(with_spinner("Embree harness: builds", || run_embree(a, &cam, light.position, "none", a.builds))?);
 
-    // The thesis's tree for single rays and packets, and the one with the bundle methods' cost model
-    // (`KdParams::for_method`) for frustums, MFT and cones.
+    // The thesis's tree for single rays, and the one with the packet methods' cost model
+    // (`KdParams::for_method`) for packets, frustums, MFT and cones.
     let params = [a.kd.params()?, a.kd.params_for(Method::Mft)?];
     let mut builds = Vec::new();
     let mut trees: [Option<KdTree>; 2] = [None, None];
@@ -184,7 +184,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         });
         builds.push((t, thesis, bundles));
     }
-    let [Some(tree), Some(bundle_tree)] = trees else { return Err("--threads: no thread count given".into()) };
+    let [Some(tree), Some(packet_tree)] = trees else { return Err("--threads: no thread count given".into()) };
     let reference = BruteForce::new(&scene);
     let (w, h) = a.image.size();
     let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree));
@@ -219,7 +219,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             let tiles: Vec<u64> = if method.uses_tiles() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
             for &tile in &tiles {
                 for &t in &a.threads {
-                    let walked = if method.is_bundled() { &bundle_tree } else { &tree };
+                    let walked = if method.uses_packets() { &packet_tree } else { &tree };
                     let tracer = Tracer::new(walked, None, TraceOptions { method, ..Default::default() });
                     let (report, results) = measure(
                         &tracer,
@@ -278,7 +278,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     }
     let _ = writeln!(
         md,
-        "\n| build | threads | raylab kd-tree (SAH, perfect splits, C_trav {}) s | the bundle methods' kd-tree (C_trav {}) s | Embree BVH (HIGH) s |",
+        "\n| build | threads | raylab kd-tree (SAH, perfect splits, C_trav {}) s | the packet methods' kd-tree (C_trav {}) s | Embree BVH (HIGH) s |",
         params[0].c_trav, params[1].c_trav
     );
     let _ = writeln!(md, "|---|---:|---:|---:|---:|");
@@ -294,8 +294,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             md,
             "\nCoherent methods against Embree's best packet or stream API for the same rays and thread count \
              ({} backend; N = nodes per {packet} packet, I = triangle tests per {packet} packet, culled = \
-             packet/leaf visits culled; packets walk the thesis's kd-tree, the bundle methods their own, with \
-             C_trav {}):\n",
+             packet/leaf visits culled; every method here walks the packet methods' kd-tree, with C_trav {}):\n",
             backend.name(),
             params[1].c_trav
         );

@@ -54,23 +54,24 @@ impl KdParams {
     /// Hard limit on the depth; the traversal stacks are sized from it.
     pub const DEPTH_LIMIT: u32 = 60;
 
-    /// `c_trav` of the trees that the bundle methods (frustum, MFT, cone, MFT over cones) walk, against the
-    /// thesis's 1 (with `c_isect` 5 in both).
+    /// `c_trav` of the trees that the packet methods (packets, frustum, MFT, cone, MFT over cones) walk,
+    /// against the thesis's 1 (with `c_isect` 5 in both).
     ///
     /// A frustum walk pays a node step once for a whole tile, but at each leaf it tests every packet of the
     /// (sub)frustum against the leaf's box before any triangle, and on Sponza's primary rays a leaf of the
-    /// thesis's tree (2.4 triangles) serves about two rays: its visits, not its triangle tests, dominate.
-    /// The SAH has no term for a leaf visit, so the split cost carries it; a larger `c_trav` gives fewer,
-    /// fuller leaves (Sponza: 151k nodes and 5.1 triangles per leaf against 473k and 2.4). 12 is the best
-    /// of a sweep over 1-24 for MFT, frustum and cone on primary and shadow rays with AVX2 and AVX-512
-    /// (1.2-1.4x the rays per second of the thesis's tree; docs/BENCHMARKS.md); single rays and 2x2
-    /// packets gain nothing from it, so they keep the thesis's model.
-    pub const BUNDLE_C_TRAV: f32 = 12.0;
+    /// thesis's tree (2.4 triangles) serves about two rays: its visits, not its triangle tests, dominate. A
+    /// packet's SIMD triangle test, too, costs little against a step of its walk. The SAH has no term for a
+    /// leaf visit, so the split cost carries it; a larger `c_trav` gives fewer, fuller leaves (Sponza: 151k
+    /// nodes and 5.1 triangles per leaf against 473k and 2.4). 12 is the best of a sweep over 1-24 for
+    /// MFT, frustum and cone on primary and shadow rays with AVX2 and AVX-512 (1.2-1.5x the rays per second
+    /// of the thesis's tree), and packets gain 1.05-1.15x on primary, shadow and diffuse rays
+    /// (docs/BENCHMARKS.md); single rays move within the noise, so they keep the thesis's model.
+    pub const PACKET_C_TRAV: f32 = 12.0;
 
-    /// The cost model for a tree that `method` walks: [`KdParams::BUNDLE_C_TRAV`] for the bundle methods
-    /// ([`Method::is_bundled`]), the thesis's (the default) for every other.
+    /// The cost model for a tree that `method` walks: [`KdParams::PACKET_C_TRAV`] for the packet methods
+    /// ([`Method::uses_packets`]), the thesis's (the default) for every other.
     pub fn for_method(method: Method) -> Self {
-        let c_trav = if method.is_bundled() { Self::BUNDLE_C_TRAV } else { Self::default().c_trav };
+        let c_trav = if method.uses_packets() { Self::PACKET_C_TRAV } else { Self::default().c_trav };
         Self { c_trav, ..Self::default() }
     }
 

@@ -386,7 +386,7 @@ impl Lab {
             self.loading = None;
             match *result {
                 Ok(s) => {
-                    let kd_s = s.kd.build_s + s.bundle_kd.as_ref().map_or(0.0, |b| b.build_s);
+                    let kd_s = s.kd.build_s + s.packet_kd.as_ref().map_or(0.0, |b| b.build_s);
                     self.message(
                         format!(
                             "loaded {}: {} triangles in {:.2} s (kd-trees {:.2} s)",
@@ -575,7 +575,7 @@ mod tests {
     use crate::settings::{DistributionControls, RenderMode};
 
     fn lab(method: Method) -> Lab {
-        let kd = TreeParams { thesis: KdParams::for_method(Method::Mono), bundles: KdParams::for_method(Method::Mft) };
+        let kd = TreeParams { thesis: KdParams::for_method(Method::Mono), packets: KdParams::for_method(Method::Mft) };
         let scene = load_now(&SceneArgs::named("arena"), &kd, &|_| {}).unwrap();
         let settings = ViewerSettings {
             mode: RenderMode::Whitted,
@@ -674,18 +674,18 @@ mod tests {
         run_ui(&mut l);
     }
 
-    /// Frustum methods walk the tree built for them, single rays and packets the thesis's, and the pixels
+    /// Packets and frustums walk the tree built for them, the single-ray methods the thesis's, and the pixels
     /// are the same either way.
     #[test]
     fn each_method_walks_its_own_kd_tree() {
         let mut l = lab(Method::Mft);
         l.set_window_size(40, 24);
         let s = l.scene();
-        let (thesis, bundles) = (s.kd_for(Method::Mono), s.kd_for(Method::Mft));
+        let (thesis, packets) = (s.kd_for(Method::Mono), s.kd_for(Method::Mft));
         assert_eq!(thesis.tree.params().c_trav, KdParams::for_method(Method::Mono).c_trav);
-        assert_eq!(bundles.tree.params().c_trav, KdParams::BUNDLE_C_TRAV);
-        assert!(bundles.stats.nodes < thesis.stats.nodes, "{} vs {} nodes", bundles.stats.nodes, thesis.stats.nodes);
-        assert!(std::ptr::eq(s.kd_for(Method::Packet), thesis) && std::ptr::eq(s.kd_for(Method::Cone), bundles));
+        assert_eq!(packets.tree.params().c_trav, KdParams::PACKET_C_TRAV);
+        assert!(packets.stats.nodes < thesis.stats.nodes, "{} vs {} nodes", packets.stats.nodes, thesis.stats.nodes);
+        assert!(std::ptr::eq(s.kd_for(Method::MbvhRs), thesis) && std::ptr::eq(s.kd_for(Method::Packet), packets));
         let job = l.job();
         let frames: Vec<_> = [Method::Mono, Method::Packet, Method::Mft, Method::Frustum]
             .into_iter()
