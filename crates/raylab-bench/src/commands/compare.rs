@@ -57,7 +57,7 @@ pub struct CompareArgs {
     #[arg(long, value_delimiter = ',', default_value = "256,4096", value_parser = parse_group)]
     rs_groups: Vec<u64>,
     /// Tile sizes for the frustum methods.
-    #[arg(long, value_delimiter = ',', default_value = "4,8,16", value_parser = in_range(2, 256))]
+    #[arg(long, value_delimiter = ',', default_value = "4,8,16,32", value_parser = in_range(2, 256))]
     tiles: Vec<u64>,
     /// Also write the markdown to this file.
     #[arg(long)]
