@@ -72,10 +72,11 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         .ok_or("frame buffer size mismatch")?;
     img.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
     println!(
-        "{}: {} triangles, loaded in {:.3} s, kd-tree in {:.3} s; rendered {}x{} with {} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",
+        "{}: {} triangles, loaded in {:.3} s, kd-tree (C_trav {}) in {:.3} s; rendered {}x{} with {} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",
         a.scene.scene,
         scene.triangle_count(),
         load_s,
+        tree.params().c_trav,
         tree.build_time().as_secs_f64(),
         frame.width,
         frame.height,

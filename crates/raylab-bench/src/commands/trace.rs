@@ -116,6 +116,8 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
             "cull": options.cull,
             "backend": options.backend.name(),
             "kd_build_seconds": tree.build_time().as_secs_f64(),
+            "kd_params": tree.params(),
+            "kd_nodes": tree.nodes().len(),
             "mbvh": mbvh.as_ref().map(Mbvh::stats),
             "validated_rays": checked,
             "result": report,
@@ -125,7 +127,15 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     }
     println!("environment      {}", env.line());
     println!("scene            {} ({} triangles), {}x{}", a.scene.scene, scene.triangle_count(), w, h);
-    println!("kd-tree          built in {:.3} s on {} thread(s)", tree.build_time().as_secs_f64(), a.threads);
+    let kd = tree.params();
+    println!(
+        "kd-tree          C_trav {}, C_isect {}: {} nodes, built in {:.3} s on {} thread(s)",
+        kd.c_trav,
+        kd.c_isect,
+        tree.nodes().len(),
+        tree.build_time().as_secs_f64(),
+        a.threads
+    );
     if let Some(m) = &mbvh {
         let st = m.stats();
         println!(

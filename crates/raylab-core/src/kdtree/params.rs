@@ -61,8 +61,8 @@ impl KdParams {
     /// (sub)frustum against the leaf's box before any triangle, and on Sponza's primary rays a leaf of the
     /// thesis's tree (2.4 triangles) serves about two rays: its visits, not its triangle tests, dominate. A
     /// packet's SIMD triangle test, too, costs little against a step of its walk. The SAH has no term for a
-    /// leaf visit, so the split cost carries it; a larger `c_trav` gives fewer, fuller leaves (Sponza: 151k
-    /// nodes and 5.1 triangles per leaf against 473k and 2.4). 12 is the best of a sweep over 1-24 for
+    /// leaf visit, so the split cost carries it; a larger `c_trav` gives fewer, fuller leaves (Sponza: 130k
+    /// nodes and 5.7 triangles per leaf against 473k and 2.4). 12 is the best of a sweep over 1-24 for
     /// MFT, frustum and cone on primary and shadow rays with AVX2 and AVX-512 (1.2-1.5x the rays per second
     /// of the thesis's tree), and packets gain 1.05-1.15x on primary, shadow and diffuse rays
     /// (docs/BENCHMARKS.md); single rays move within the noise, so they keep the thesis's model.
