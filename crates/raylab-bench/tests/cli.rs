@@ -51,6 +51,12 @@ fn info_reports_tree_statistics() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(v["triangles"].as_u64().unwrap() > 10_000);
     assert!(v["kdtree"]["leaves"].as_u64().unwrap() > 1 && v["kdtree"]["sah_cost"].as_f64().unwrap() > 0.0);
+    // The packet methods' tree has its own cost model, and fewer, fuller leaves.
+    let o = bench(&["info", "--scene", "arena", "--method", "mft", "--json"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let w: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((v["kd_params"]["c_trav"].as_f64(), w["kd_params"]["c_trav"].as_f64()), (Some(1.0), Some(12.0)));
+    assert!(w["kdtree"]["leaves"].as_u64().unwrap() < v["kdtree"]["leaves"].as_u64().unwrap(), "{w}");
 }
 
 #[test]

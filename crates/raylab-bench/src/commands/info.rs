@@ -14,6 +14,9 @@ pub struct InfoArgs {
     scene: SceneArgs,
     #[command(flatten)]
     kd: KdArgs,
+    /// Build the kd-tree that this method walks (its cost model: packet and frustum methods have their own).
+    #[arg(long, default_value = "mono")]
+    method: raylab_core::method::Method,
     /// Threads for the kd-tree build.
     #[arg(long, default_value_t = 1, value_parser = in_range(1, 1024))]
     threads: u64,
@@ -25,7 +28,7 @@ pub struct InfoArgs {
 /// Runs the command.
 pub fn run(a: &InfoArgs) -> Result<(), String> {
     let (raylab_scene::Loaded { scene, warnings }, load_s) = load_scene_verbose(&a.scene.source())?;
-    let params = a.kd.params()?;
+    let params = a.kd.params_for(a.method)?;
     let tree = build_tree(&scene, &params, a.threads as usize)?;
     let st = tree.stats();
     let b = scene.bounds();
