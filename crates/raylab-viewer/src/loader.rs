@@ -12,7 +12,7 @@ use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::scene::{Camera, PointLight, Scene};
 
-/// The kd-tree cost models a scene's trees are built with: one for single rays and packets (the thesis's)
+/// The kd-tree cost models a scene's trees are built with: one for the single-ray methods (the thesis's)
 /// and one for the packet methods ([`KdParams::for_method`]), each with the command line's changes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TreeParams {
@@ -53,7 +53,7 @@ pub struct LoadedScene {
     pub name: String,
     /// The scene.
     pub scene: Scene,
-    /// Its kd-tree for single rays and packets.
+    /// Its kd-tree for the single-ray methods (the thesis's cost model).
     pub kd: BuiltTree,
     /// Its kd-tree for the packet methods, when their parameters differ.
     pub packet_kd: Option<BuiltTree>,
