@@ -210,12 +210,13 @@ impl KdArgs {
     /// The parameters of the tree that `method` walks ([`KdParams::for_method`]), with the flags' changes;
     /// checked, and the error names the flag.
     pub fn params_for(&self, method: Method) -> Result<KdParams, String> {
+        let base = KdParams::for_method(method);
         let p = KdParams {
-            c_trav: self.kd_ctrav.unwrap_or(KdParams::for_method(method).c_trav),
+            c_trav: self.kd_ctrav.unwrap_or(base.c_trav),
             c_isect: self.kd_cisect,
             empty_bonus: self.kd_empty_bonus,
             max_depth: self.kd_max_depth.map(|d| d as u32),
-            ..KdParams::for_method(method)
+            ..base
         };
         p.validate().map_err(|m| format!("--kd-*: {m}"))?;
         Ok(p)

@@ -178,11 +178,11 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                 trees[k] = Some(built);
             }
         }
-        let [thesis, bundles] = times.map(|mut v| {
+        let [thesis, packets] = times.map(|mut v| {
             v.sort_by(f64::total_cmp);
             v[v.len() / 2]
         });
-        builds.push((t, thesis, bundles));
+        builds.push((t, thesis, packets));
     }
     let [Some(tree), Some(packet_tree)] = trees else { return Err("--threads: no thread count given".into()) };
     let reference = BruteForce::new(&scene);
@@ -282,9 +282,9 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         params[0].c_trav, params[1].c_trav
     );
     let _ = writeln!(md, "|---|---:|---:|---:|---:|");
-    for (t, thesis, bundles) in &builds {
+    for (t, thesis, packets) in &builds {
         let e = embree.builds.iter().find(|(et, _)| et == t).map_or("n/a".into(), |(_, s)| format!("{s:.3}"));
-        let _ = writeln!(md, "| median of {} | {} | {:.3} | {:.3} | {} |", a.builds, t, thesis, bundles, e);
+        let _ = writeln!(md, "| median of {} | {} | {:.3} | {:.3} | {} |", a.builds, t, thesis, packets, e);
     }
     if !coherent.is_empty() {
         let backend = TraceOptions::default().backend;
