@@ -249,6 +249,10 @@ pub struct MethodArgs {
     /// Walk MBVH RS child tasks in lane order instead of by accumulated hit length (to measure the ordering).
     #[arg(long)]
     pub no_stream_order: bool,
+    /// How MBVH RS tests the rays reaching a leaf: blocks (two rays per eight-lane test against four-triangle
+    /// blocks) or packets (the paper's four-ray packets against one triangle at a time).
+    #[arg(long, default_value = "blocks")]
+    pub stream_leaves: raylab_core::mbvh::StreamLeaves,
     /// DACRT: a node with at most this many rays is tested naively (below the division made at setup).
     #[arg(long, default_value_t = 8, value_parser = in_range(1, raylab_core::dacrt::DacrtParams::MAX_LEAF as u64))]
     pub dacrt_leaf_rays: u64,
@@ -300,6 +304,7 @@ impl MethodArgs {
             backend: self.backend.unwrap_or_else(raylab_simd::Backend::detect),
             shadow_spread_limit: self.shadow_spread_limit,
             stream_order: !self.no_stream_order,
+            stream_leaves: self.stream_leaves,
             dacrt: raylab_core::dacrt::DacrtParams {
                 leaf_rays: self.dacrt_leaf_rays as usize,
                 leaf_tris: self.dacrt_leaf_tris as usize,

@@ -20,7 +20,7 @@ use raylab_simd::{VMask, Vf32};
 use rayon::prelude::*;
 
 use crate::packet::sheared_test;
-use crate::ray::Hit;
+use crate::ray::{Hit, Ray};
 use crate::triangle::{RayShear, TriHit, TriangleSoup};
 
 /// Marks a padding slot in a leaf-ordered triangle-id array.
@@ -194,10 +194,113 @@ impl<V: Vf32> ShearX4<V> {
     }
 }
 
+/// A ray's watertight-test constants as two rows of four floats, so that a group of four lanes loads them
+/// with one broadcast each: the origin in the shear's `(kx, ky, kz)` order and `tmin`, then `(S_x, S_y, S_z)`
+/// and the far limit; and the axes. Computed once per ray of an MBVH ray stream, whose rays reach many
+/// leaves ([`ShearGroups`]).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct ShearRecord {
+    rows: [[f32; 4]; 2],
+    axes: [usize; 3],
+}
+
+impl ShearRecord {
+    /// The constants of `ray` (its direction must not be zero), with its own `tmax` as the far limit.
+    pub fn new(ray: &Ray) -> Self {
+        let shear = RayShear::new(ray);
+        let (axes, o, s) = (shear.axes(), shear.origin().to_array(), shear.shear());
+        Self { rows: [[o[axes[0]], o[axes[1]], o[axes[2]], ray.tmin], [s[0], s[1], s[2], ray.tmax]], axes }
+    }
+
+    /// The far limit hits must not pass (`tmax`, or the closest hit so far).
+    pub fn tmax(&self) -> f32 {
+        self.rows[1][3]
+    }
+
+    /// Sets the far limit.
+    pub fn set_tmax(&mut self, t: f32) {
+        self.rows[1][3] = t;
+    }
+}
+
+/// `V::LANES / 4` rays (one per group of four lanes) against four triangles at once: lane `4g + j` tests ray
+/// `g` against lane `j` of a [`Tri4`] block, so eight lanes test two rays and sixteen four, where a packet
+/// test ([`crate::packet`]) takes four rays against one triangle. Each group reads the block's coordinates
+/// in its own ray's axis order ([`Vf32::from_quads`]), so rays whose shears permute the axes differently
+/// share a test without per-lane selects. Every lane performs [`RayShear::intersect`]'s `f32` operations in
+/// its order, and exactly zero edge functions are redone by that test, as [`ShearX4`] does for one ray.
+pub struct ShearGroups<V: Vf32> {
+    org: [V; 3],
+    s: [V; 3],
+    tmin: V,
+    axes: [[usize; 3]; 4],
+}
+
+impl<V: Vf32> ShearGroups<V> {
+    /// Ray `g`'s constants `records[g]` in group `g`; groups past `V::LANES / 4` are ignored.
+    #[inline(always)]
+    pub fn new(records: [&ShearRecord; 4]) -> Self {
+        let [ox, oy, oz, tmin] = V::splat_rows(&records.map(|r| &r.rows[0]));
+        let [sx, sy, sz, _] = V::splat_rows(&records.map(|r| &r.rows[1]));
+        Self { org: [ox, oy, oz], s: [sx, sy, sz], tmin, axes: records.map(|r| r.axes) }
+    }
+
+    /// The groups' far limits, ray `g`'s [`ShearRecord::tmax`] in group `g`.
+    #[inline(always)]
+    pub fn limits(records: [&ShearRecord; 4]) -> V {
+        V::splat_rows(&records.map(|r| &r.rows[1]))[3]
+    }
+
+    /// Corner `c` of every lane's triangle relative to its ray's origin, in that ray's `(kx, ky, kz)` order.
+    #[inline(always)]
+    fn corner(&self, b: &Tri4, c: usize) -> (V, V, V) {
+        let a = &self.axes;
+        let pick = |i: usize| V::from_quads(&[&b.v[c][a[0][i]], &b.v[c][a[1][i]], &b.v[c][a[2][i]], &b.v[c][a[3][i]]]);
+        (pick(0) - self.org[0], pick(1) - self.org[1], pick(2) - self.org[2])
+    }
+
+    /// Tests every group's ray against the four triangles of `b`, reporting hits with `tmin < t <= tmax`
+    /// (`tmax` per lane) as [`RayShear::intersect`] does. `ray(g)` is group `g`'s ray, for the rare lanes
+    /// the scalar test must decide.
+    #[inline(always)]
+    pub fn test(&self, b: &Tri4, tmax: V, ray: impl Fn(usize) -> Ray) -> BlockHits<V> {
+        let corners = [self.corner(b, 0), self.corner(b, 1), self.corner(b, 2)];
+        let lanes = sheared_test(corners, self.s, self.tmin, tmax);
+        let hits = BlockHits { mask: lanes.hit, t: lanes.t, u: lanes.u, v: lanes.v };
+        if lanes.exact_zero.none() { hits } else { Self::redo(b, hits, lanes.exact_zero.bits(), tmax, ray) }
+    }
+
+    /// Rare: lanes with an exactly zero edge function, which the scalar test decides in double precision.
+    #[cold]
+    fn redo(b: &Tri4, hits: BlockHits<V>, lanes: u32, tmax: V, ray: impl Fn(usize) -> Ray) -> BlockHits<V> {
+        let (mut t, mut u, mut v) = ([0f32; 16], [0f32; 16], [0f32; 16]);
+        let n = V::LANES;
+        hits.t.write_to(&mut t[..n]);
+        hits.u.write_to(&mut u[..n]);
+        hits.v.write_to(&mut v[..n]);
+        let mut bits = hits.mask.bits();
+        for lane in (0..n).filter(|i| lanes >> i & 1 == 1) {
+            let ray = ray(lane / 4);
+            let tri = b.triangle(lane % 4);
+            if let Some(TriHit { t: ht, u: hu, v: hv }) = RayShear::new(&ray).intersect(&tri, ray.tmin, tmax.lane(lane))
+            {
+                (t[lane], u[lane], v[lane]) = (ht, hu, hv);
+                bits |= 1 << lane;
+            }
+        }
+        BlockHits {
+            mask: V::Mask::from_bits(bits),
+            t: V::from_slice(&t[..n]),
+            u: V::from_slice(&u[..n]),
+            v: V::from_slice(&v[..n]),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ray::Ray;
 
     /// Lanes of a block report bit for bit what the scalar test reports, exact-zero edges included.
     fn lanes<V: Vf32>() {
@@ -225,6 +328,57 @@ mod tests {
                 let have = (bits >> lane & 1 == 1).then(|| (got.t.lane(lane), got.u.lane(lane), got.v.lane(lane)));
                 assert_eq!(have, want, "ray {ray:?} lane {lane}");
             }
+        }
+    }
+
+    /// Every lane of a group test reports bit for bit what the scalar test reports for its ray and
+    /// triangle: rays with different axis orders (and an exactly zero edge function) in one test.
+    struct Groups;
+
+    impl raylab_simd::Kernel for Groups {
+        type Output = ();
+        fn run<V: Vf32>(self) {
+            let tris = [
+                [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+                [Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+                [Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 1.0, 0.5), Vec3::new(1.0, 0.0, 0.5)],
+                [Vec3::new(0.3, -1.0, -1.0), Vec3::new(0.3, 2.0, -1.0), Vec3::new(0.3, -1.0, 2.0)],
+            ];
+            let block = Tri4::pack(&tris);
+            let rays = [
+                Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0)),
+                // Through the shared edge (exact zero edge functions).
+                Ray::new(Vec3::new(0.5, 0.5, -2.0), Vec3::new(0.0, 0.0, 1.0)),
+                Ray::new(Vec3::new(-1.0, 0.3, 0.25), Vec3::new(1.2, 0.0, 0.1)),
+                Ray::segment(Vec3::new(0.2, 3.0, 0.2), Vec3::new(0.05, -1.0, -0.02), 0.5, 2.9),
+                Ray::new(Vec3::new(2.0, 0.2, 0.1), Vec3::new(-1.0, 0.1, 0.0)),
+            ];
+            let records = rays.map(|r| ShearRecord::new(&r));
+            // Every window of four rays, wrapping, so each ray takes every group position.
+            let mut hits = 0;
+            for first in 0..rays.len() {
+                let pick = |g: usize| (first + g) % rays.len();
+                let recs = [0, 1, 2, 3].map(|g| &records[pick(g)]);
+                let groups = ShearGroups::<V>::new(recs);
+                let got = groups.test(&block, ShearGroups::<V>::limits(recs), |g| rays[pick(g)]);
+                let bits = got.mask.bits();
+                for lane in 0..V::LANES {
+                    let ray = rays[pick(lane / 4)];
+                    let want =
+                        RayShear::new(&ray).intersect(&tris[lane % 4], ray.tmin, ray.tmax).map(|h| (h.t, h.u, h.v));
+                    let have = (bits >> lane & 1 == 1).then(|| (got.t.lane(lane), got.u.lane(lane), got.v.lane(lane)));
+                    assert_eq!(have, want, "ray {ray:?} lane {lane} of {}", V::LANES);
+                    hits += usize::from(have.is_some());
+                }
+            }
+            assert!(hits >= rays.len(), "the rays hit the block ({hits} lane hits)");
+        }
+    }
+
+    #[test]
+    fn group_lanes_equal_the_scalar_test_on_every_backend() {
+        for b in raylab_simd::Backend::available() {
+            raylab_simd::dispatch(b, Groups);
         }
     }
 

@@ -170,9 +170,11 @@ fn every_triangle_is_covered_by_its_leaves_and_lanes_are_well_formed() {
 }
 
 /// MBVH RS (ray streams) against brute force: incoherent and adversarial rays in groups of 2^4 to 2^12, with
-/// and without the ordering heuristic, closest hits and occlusion.
+/// and without the ordering heuristic, with both leaf tests, closest hits (triangle and distance) and
+/// occlusion.
 #[test]
 fn ray_streams_match_brute_force() {
+    use raylab_core::mbvh::StreamLeaves;
     use raylab_core::method::Method;
     use raylab_core::trace::{TraceOptions, Tracer};
     for name in ["atrium", "forest"] {
@@ -189,26 +191,26 @@ fn ray_streams_match_brute_force() {
             for ((r, h), b) in rays.iter().zip(hits).zip(blocked) {
                 let r = r.unwrap();
                 let want = bf.intersect(&r, &mut TraversalStats::default());
-                match (h, want) {
-                    (Some(h), Some(w)) => assert!(
-                        (h.t - w.t).abs() <= 1e-5 * w.t.abs().max(1e-30),
-                        "{name} {label}: {r:?}: {h:?} vs {w:?}"
-                    ),
-                    (h, w) => assert_eq!(*h, w, "{name} {label}: {r:?}"),
-                }
+                assert_eq!(h.map(|h| (h.tri, h.t)), want.map(|w| (w.tri, w.t)), "{name} {label}: {r:?}");
                 assert_eq!(*b, bf.occluded(&r, &mut TraversalStats::default()), "{name} {label}: {r:?}");
             }
         };
-        // Every backend: eight lanes test two rays per node, four one, a task's rays eight or four at a time
-        // (odd and partial last chunks included).
-        // Both trees: the default build and one with spatial splits everywhere.
+        // Every backend: eight lanes test two rays per node and per leaf block test, four one, a task's rays
+        // eight or four at a time (odd and partial last chunks included). Both leaf tests, both trees (the
+        // default build and one with spatial splits everywhere).
         let cases = Backend::available().into_iter().flat_map(|b| {
             [(16, true), (256, true), (256, false), (4095, true)].into_iter().map(move |(g, o)| (b, g, o))
         });
+        let cases = cases.flat_map(|c| StreamLeaves::ALL.map(|l| (c, l)));
         let spatial = Mbvh::build_with(&scene, &spatial_everywhere());
         let cases = cases.flat_map(|c| [("default", &m, c), ("spatial", &spatial, c)]);
-        for (tree, m, (backend, group, ordered)) in cases {
-            let opts = TraceOptions { method: Method::MbvhRs, stream_order: ordered, ..TraceOptions::default() };
+        for (tree, m, ((backend, group, ordered), leaves)) in cases {
+            let opts = TraceOptions {
+                method: Method::MbvhRs,
+                stream_order: ordered,
+                stream_leaves: leaves,
+                ..TraceOptions::default()
+            };
             let mut m = m.clone();
             m.backend = backend;
             let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
@@ -218,7 +220,7 @@ fn ray_streams_match_brute_force() {
                 let mut blocked = vec![false; chunk.len()];
                 tracer.intersect_tile(chunk, chunk.len(), 1, &mut hits, &mut s);
                 tracer.occluded_tile(chunk, chunk.len(), 1, None, &mut blocked, &mut s);
-                check(&format!("{tree} tree, group {group}"), chunk, &hits, &blocked);
+                check(&format!("{tree} tree, group {group}, {} leaves", leaves.name()), chunk, &hits, &blocked);
             }
             assert_eq!(s.rays, 2 * total);
             assert!(s.box_tests > 0 && s.leaf_rays > 0);
@@ -243,6 +245,50 @@ fn ray_streams_match_brute_force() {
         }
         // Smaller groups share fewer node fetches: the tile really was cut.
         assert!(fetches[0] > fetches[1] && fetches[1] > fetches[2], "{name}: {fetches:?}");
+    }
+}
+
+/// MBVH RS on the degenerate scenes: empty, one triangle (rays in its plane and along axes among them), huge
+/// and tiny coordinates; every backend, both leaf tests, hits and occlusion exactly as brute force.
+#[test]
+fn ray_streams_on_degenerate_scenes() {
+    use raylab_core::mbvh::StreamLeaves;
+    use raylab_core::method::Method;
+    use raylab_core::trace::{TraceOptions, Tracer};
+    let mut b = SceneBuilder::new();
+    b.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+    b.triangles = vec![Triangle { v: [0, 1, 2], material: 0 }];
+    let mut scenes = vec![("empty".to_string(), SceneBuilder::new().build()), ("one".to_string(), b.build())];
+    scenes.extend(scaled_scenes());
+    for (name, scene) in scenes {
+        let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let bf = BruteForce::new(&scene);
+        let mut rays = vec![Ray::new(Vec3::new(-1.0, 0.0, 0.0), Vec3::X), Ray::new(Vec3::new(0.5, -1.0, 0.0), Vec3::Y)];
+        rays.push(Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::NEG_Z));
+        if scene.triangle_count() > 0 {
+            rays.extend(adversarial_rays(&scene, &kd, 60, 13));
+        }
+        let rays: Vec<Option<Ray>> = rays.into_iter().map(Some).collect();
+        let mut m = Mbvh::build(&scene);
+        for backend in Backend::available() {
+            m.backend = backend;
+            for leaves in StreamLeaves::ALL {
+                let opts = TraceOptions { method: Method::MbvhRs, stream_leaves: leaves, ..TraceOptions::default() };
+                let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
+                let mut s = TraversalStats::default();
+                let mut hits = vec![None; rays.len()];
+                let mut blocked = vec![false; rays.len()];
+                tracer.intersect_tile(&rays, rays.len(), 1, &mut hits, &mut s);
+                tracer.occluded_tile(&rays, rays.len(), 1, None, &mut blocked, &mut s);
+                let what = format!("{name}, {}, {} leaves", backend.name(), leaves.name());
+                for ((r, h), b) in rays.iter().zip(&hits).zip(&blocked) {
+                    let r = r.unwrap();
+                    let want = bf.intersect(&r, &mut TraversalStats::default());
+                    assert_eq!(h.map(|h| (h.tri, h.t)), want.map(|w| (w.tri, w.t)), "{what}: {r:?}");
+                    assert_eq!(*b, bf.occluded(&r, &mut TraversalStats::default()), "{what}: {r:?}");
+                }
+            }
+        }
     }
 }
 

@@ -111,6 +111,10 @@ pub trait Vf32:
     fn splat_rows(rows: &[&[f32; 4]]) -> [Self; 4];
     /// `quad` repeated in every group of four lanes (a four-wide node's planes, once per ray).
     fn repeat4(quad: &[f32; 4]) -> Self;
+    /// Quad `quads[g]` in lanes `4g..4g + 4`: four-float rows picked per group (each ray of an MBVH ray
+    /// stream's leaf test reads a four-triangle block's coordinates in its own axis order). `quads` must hold
+    /// at least `LANES / 4` rows.
+    fn from_quads(quads: &[&[f32; 4]]) -> Self;
     /// Smallest lane (NaN lanes are ignored unless all are NaN).
     #[inline(always)]
     fn reduce_min(self) -> f32 {
@@ -350,6 +354,7 @@ mod tests {
             let refs: Vec<&[f32; 4]> = rows.iter().collect();
             let spread = V::splat_rows(&refs);
             let quad = V::repeat4(&[1.0, 2.0, 3.0, 4.0]);
+            let quads = V::from_quads(&refs[3..]);
             for i in 0..n {
                 let g = i / 4;
                 assert_eq!(
@@ -358,6 +363,8 @@ mod tests {
                 );
                 assert!(spread[3].lane(i).is_nan());
                 assert_eq!(quad.lane(i), (i % 4 + 1) as f32);
+                let row = &rows[3 + g];
+                assert_eq!(quads.lane(i).to_bits(), row[i % 4].to_bits(), "from_quads lane {i}");
             }
             let groups = V::transpose4(std::array::from_fn(|j| {
                 V::from_slice(&(0..n).map(|i| (100 * j + i) as f32).collect::<Vec<_>>())

@@ -159,6 +159,10 @@ impl Vf32 for F32x4 {
     fn repeat4(quad: &[f32; 4]) -> Self {
         Self(*quad)
     }
+    #[inline(always)]
+    fn from_quads(quads: &[&[f32; 4]]) -> Self {
+        Self(*quads[0])
+    }
 }
 
 /// Left-packs four ids ([`Vf32::pack_u32`]) without vector instructions: each id is written at the next free

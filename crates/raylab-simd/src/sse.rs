@@ -193,4 +193,9 @@ impl Vf32 for F32x4 {
         // SAFETY: `quad` is four readable `f32`s and `loadu` has no alignment requirement.
         Self(unsafe { _mm_loadu_ps(quad.as_ptr()) })
     }
+    #[inline(always)]
+    fn from_quads(quads: &[&[f32; 4]]) -> Self {
+        // SAFETY: the quad is a reference to four readable `f32`s and `loadu` has no alignment requirement.
+        Self(unsafe { _mm_loadu_ps(quads[0].as_ptr()) })
+    }
 }

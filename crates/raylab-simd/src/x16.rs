@@ -245,4 +245,9 @@ impl Vf32 for F32x16 {
     fn repeat4(quad: &[f32; 4]) -> Self {
         Self(load_blocks([quad; 4]))
     }
+    #[inline(always)]
+    fn from_quads(quads: &[&[f32; 4]]) -> Self {
+        assert!(quads.len() >= 4);
+        Self(load_blocks([quads[0], quads[1], quads[2], quads[3]]))
+    }
 }

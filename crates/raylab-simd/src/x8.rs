@@ -249,4 +249,11 @@ impl Vf32 for F32x8 {
         // `avx!`).
         Self(unsafe { _mm256_loadu2_m128(quad.as_ptr(), quad.as_ptr()) })
     }
+    #[inline(always)]
+    fn from_quads(quads: &[&[f32; 4]]) -> Self {
+        assert!(quads.len() >= 2);
+        // SAFETY: each quad is a reference to four readable `f32`s and `loadu` has no alignment requirement;
+        // AVX is present (see `avx!`).
+        Self(unsafe { _mm256_loadu2_m128(quads[1].as_ptr(), quads[0].as_ptr()) })
+    }
 }

@@ -9,6 +9,7 @@ mod stream;
 
 pub use node::{EMPTY, MbvhNode};
 pub use refit::RefitError;
+pub use stream::{StreamLeaves, StreamOptions};
 
 use std::time::{Duration, Instant};
 

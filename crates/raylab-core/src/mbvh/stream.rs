@@ -2,12 +2,19 @@
 //! the 4-wide tree breadth-first. Each task is (node, lane, count): the `count` ray ids on top of lane
 //! `lane`'s active-ray stack reached `node`. Every such ray is tested against the node's four boxes at once and
 //! its id pushed onto the stack of each lane it hits; tasks for the children then go on the task stack,
-//! ordered by the hit distances accumulated per lane (nearest last, so it is walked first). At a leaf the
-//! active rays are packed four at a time into temporary SoA packets and tested against one triangle per step;
-//! one or two rays left over after the whole packets test the leaf's triangles four at a time instead (the
-//! single-ray leaf test), since a packet of them would leave most lanes idle. The leaf counters (Figure 6's
-//! primitive tests) count SIMD tests either way: packet against triangle, or ray against four triangles.
-//! Shadow rays leave the stream at their first hit.
+//! ordered by the hit distances accumulated per lane (nearest last, so it is walked first). Shadow rays
+//! leave the stream at their first hit.
+//!
+//! Leaves are tested one of two ways ([`StreamLeaves`]). The paper's: the active rays packed four at a time
+//! into temporary SoA packets, each tested against one triangle per step, with one or two rays left over after
+//! the whole packets testing the leaf's triangles four at a time instead (the single-ray leaf test), since a
+//! packet of them would leave most lanes idle. The default: a vector's worth of rays at a time against the
+//! leaf's four-triangle blocks, each group of four lanes one ray against four triangles
+//! ([`crate::tri4::ShearGroups`]), with every ray's shear computed once per stream. Few rays reach a leaf
+//! together in a scattered group (on Sponza's diffuse rays 5.3 per leaf visit at 2^12 and 2.3 at 2^8), so
+//! the paper's packets run part empty, while a block is full whenever the leaf is; and a packet gathers its
+//! rays' constants anew at every leaf. The leaf counters (Figure 6's primitive tests) count SIMD tests:
+//! packet against triangle, or ray against four triangles.
 //!
 //! What the box tests read of each ray (origin, inverse direction, `tmin`, current limit) lives in a 32-byte
 //! record apart from the rest, so a 2^12-ray group's box data stays in the L2 cache. With eight SIMD lanes
@@ -21,6 +28,7 @@
 use std::ops::Range;
 
 use raylab_simd::{Kernel, VMask, Vf32};
+use serde::{Deserialize, Serialize};
 
 use super::Mbvh;
 use super::node::MbvhNode;
@@ -28,11 +36,58 @@ use super::single::FAR_SLACK;
 use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
 use crate::ray::{Hit, Ray, hit_reach};
 use crate::stats::TraversalStats;
-use crate::tri4::ShearX4;
+use crate::tri4::{ShearGroups, ShearRecord, ShearX4};
 use crate::triangle::RayShear;
 
 /// Rays left over after whole packets of four, up to this many, are tested alone against the leaf.
 const ALONE_MAX: usize = 2;
+
+/// How MBVH RS tests the rays that reach a leaf against its triangles.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StreamLeaves {
+    /// The paper's leaves (Listing 1): the active rays packed four at a time into temporary SoA packets, each
+    /// packet tested against one triangle per step; one or two rays left over test the leaf's triangles four
+    /// at a time alone.
+    Packets,
+    /// A vector's worth of rays at a time against four-triangle blocks: two rays per eight-lane test, one per
+    /// four-lane test ([`ShearGroups`]), every lane busy with a ray/triangle pair whatever the number of rays,
+    /// and each ray's shear computed once per stream instead of at every leaf it reaches.
+    #[default]
+    Blocks,
+}
+
+impl StreamLeaves {
+    /// Both, in the order menus list them.
+    pub const ALL: [StreamLeaves; 2] = [StreamLeaves::Blocks, StreamLeaves::Packets];
+
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            StreamLeaves::Packets => "packets",
+            StreamLeaves::Blocks => "blocks",
+        }
+    }
+}
+
+impl std::str::FromStr for StreamLeaves {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        StreamLeaves::ALL
+            .into_iter()
+            .find(|l| l.name() == s)
+            .ok_or_else(|| format!("unknown MBVH RS leaf test '{s}' (valid: blocks, packets)"))
+    }
+}
+
+/// How a stream is walked: the child ordering heuristic and the leaf test.
+#[derive(Clone, Copy, Debug)]
+pub struct StreamOptions {
+    /// Order child tasks by accumulated hit length (the paper's heuristic); off walks them in lane order.
+    pub ordered: bool,
+    /// The leaf test.
+    pub leaves: StreamLeaves,
+}
 
 /// How many of a leaf's `rays` are tested alone: the rays left after whole packets of four, when there are at
 /// most [`ALONE_MAX`] of them.
@@ -117,6 +172,16 @@ fn keep_open(ids: &mut [u32], hot: &[Hot]) -> usize {
     open
 }
 
+/// Every ray's state in a stream, indexed by the ray's position in the group.
+struct StreamRays {
+    /// What the box tests read.
+    hot: Vec<Hot>,
+    /// The rays and their closest hits.
+    slots: Vec<Slot>,
+    /// The leaf tests' constants ([`StreamLeaves::Blocks`] only; empty otherwise).
+    records: Vec<ShearRecord>,
+}
+
 /// The rest of a ray's state in a stream.
 struct Slot {
     ray: Ray,
@@ -139,28 +204,33 @@ impl Slot {
 }
 
 impl Mbvh {
-    /// Closest hits of a group of rays traced together (`None` rays are skipped). `ordered` turns on the
-    /// accumulated-length ordering of child tasks.
+    /// Closest hits of a group of rays traced together (`None` rays are skipped).
     pub fn intersect_stream(
         &self,
         rays: &[Option<Ray>],
         out: &mut [Option<Hit>],
-        ordered: bool,
+        options: StreamOptions,
         stats: &mut TraversalStats,
     ) {
         let emit = |i: usize, _: &Hot, s: &Slot| out[i] = s.hit;
         raylab_simd::dispatch(
             self.backend.at_most_eight_lanes(),
-            Stream { mbvh: self, rays, shadow: false, ordered, stats, emit },
+            Stream { mbvh: self, rays, shadow: false, options, stats, emit },
         );
     }
 
     /// Occlusion of a group of rays traced together; each ray leaves the stream at its first blocker.
-    pub fn occluded_stream(&self, rays: &[Option<Ray>], out: &mut [bool], ordered: bool, stats: &mut TraversalStats) {
+    pub fn occluded_stream(
+        &self,
+        rays: &[Option<Ray>],
+        out: &mut [bool],
+        options: StreamOptions,
+        stats: &mut TraversalStats,
+    ) {
         let emit = |i: usize, h: &Hot, _: &Slot| out[i] = h.blocked();
         raylab_simd::dispatch(
             self.backend.at_most_eight_lanes(),
-            Stream { mbvh: self, rays, shadow: true, ordered, stats, emit },
+            Stream { mbvh: self, rays, shadow: true, options, stats, emit },
         );
     }
 
@@ -170,20 +240,27 @@ impl Mbvh {
         &self,
         rays: &[Option<Ray>],
         shadow: bool,
-        ordered: bool,
+        options: StreamOptions,
         stats: &mut TraversalStats,
         mut emit: impl FnMut(usize, &Hot, &Slot),
     ) {
+        let blocks = options.leaves == StreamLeaves::Blocks;
         assert_eq!(V::LANES, 4, "MBVH RS packs leaf rays four at a time");
         assert!(B::LANES == 4 || B::LANES == 8, "one or two rays per box test");
-        let mut hot: Vec<Hot> = Vec::with_capacity(rays.len());
-        let mut slots: Vec<Slot> = Vec::with_capacity(rays.len());
+        let mut state = StreamRays {
+            hot: Vec::with_capacity(rays.len()),
+            slots: Vec::with_capacity(rays.len()),
+            records: Vec::with_capacity(if blocks { rays.len() } else { 0 }),
+        };
         let mut ids: Vec<u32> = Vec::with_capacity(rays.len());
         for (i, r) in rays.iter().enumerate() {
             let ray = r.unwrap_or(Ray::new(glam::Vec3::ZERO, glam::Vec3::Z));
             let live = r.is_some_and(|r| r.is_valid());
-            hot.push(Hot::new(&ray));
-            slots.push(Slot { ray, hit: None });
+            state.hot.push(Hot::new(&ray));
+            if blocks {
+                state.records.push(ShearRecord::new(&ray));
+            }
+            state.slots.push(Slot { ray, hit: None });
             if live {
                 ids.push(i as u32);
             }
@@ -191,9 +268,9 @@ impl Mbvh {
         stats.rays += ids.len() as u64;
         stats.packets += ids.len().div_ceil(4) as u64;
         if !self.tri_ids.is_empty() && !ids.is_empty() {
-            self.walk_stream::<B, V>(&mut hot, &mut slots, ids, shadow, ordered, stats);
+            self.walk_stream::<B, V>(&mut state, ids, shadow, options, stats);
         }
-        for (i, (h, s)) in hot.iter().zip(&slots).enumerate() {
+        for (i, (h, s)) in state.hot.iter().zip(&state.slots).enumerate() {
             emit(i, h, s);
         }
     }
@@ -201,13 +278,14 @@ impl Mbvh {
     #[inline(always)]
     fn walk_stream<B: Vf32, V: Vf32>(
         &self,
-        hot: &mut [Hot],
-        slots: &mut [Slot],
+        state: &mut StreamRays,
         ids: Vec<u32>,
         shadow: bool,
-        ordered: bool,
+        options: StreamOptions,
         stats: &mut TraversalStats,
     ) {
+        let StreamRays { hot, slots, records } = state;
+        let blocks = options.leaves == StreamLeaves::Blocks;
         let n = ids.len() as u32;
         // Per lane, an active-ray stack: `lanes[k][..top[k]]` holds it. The storage only grows, so rays are
         // written without a branch on whether they hit the lane's box (the write is kept by advancing `top`).
@@ -234,6 +312,10 @@ impl Mbvh {
                 slots8 += c.div_ceil(8) * 8;
                 slots16 += c.div_ceil(16) * 16;
                 let tri_slots = task.child as usize..(task.child + task.tris) as usize;
+                if blocks {
+                    tests += self.leaf_groups::<B>(hot, slots, records, current, tri_slots, shadow);
+                    continue;
+                }
                 // Whole packets go through the paper's four-rays-per-triangle tests; a remainder of one or
                 // two rays would leave most lanes idle, so each such ray takes the leaf's triangles four at a
                 // time instead, as a single ray does.
@@ -306,7 +388,7 @@ impl Mbvh {
                     // The leaf's triangles in the form its tests will read: corners for packets, blocks for
                     // rays alone.
                     let slots = node.child[k] as usize..(node.child[k] + node.count[k]) as usize;
-                    let alone = alone_of(rays);
+                    let alone = if blocks { rays } else { alone_of(rays) };
                     if rays > alone {
                         raylab_simd::prefetch(self.tris.slice(slots.clone()));
                     }
@@ -320,7 +402,7 @@ impl Mbvh {
             let lengths_out: [f32; 4] = std::array::from_fn(|k| sums[k] + sums[k + 4]);
             // Children with the largest accumulated length first on the stack, so the shortest is walked first.
             let mut order = [0usize, 1, 2, 3];
-            if ordered {
+            if options.ordered {
                 // Descending by length, ties in lane order: keys of (length bits, reversed lane) through a
                 // five-comparator sorting network (lengths are sums of non-negative distances, so their bits
                 // order like the values).
@@ -366,6 +448,88 @@ impl Mbvh {
             *hot.limit_mut() = slot.reach();
         }
         blocks
+    }
+
+    /// Tests the `rays` that reached a leaf against its triangles `V::LANES / 4` rays at a time, each against
+    /// a four-triangle block per test ([`ShearGroups`]); returns the number of ray/block tests.
+    #[inline(always)]
+    fn leaf_groups<V: Vf32>(
+        &self,
+        hot: &mut [Hot],
+        slots: &mut [Slot],
+        records: &mut [ShearRecord],
+        rays: &[u32],
+        tri_slots: Range<usize>,
+        shadow: bool,
+    ) -> u64 {
+        let per = V::LANES / 4;
+        let blocks = &self.blocks[tri_slots.start / 4..tri_slots.end.div_ceil(4)];
+        let first = tri_slots.start / 4;
+        let mut tests = 0;
+        for chunk in rays.chunks(per) {
+            // Groups past the chunk's rays repeat its last ray; their lanes are masked off.
+            let last = chunk.len() - 1;
+            let id = [0, 1, 2, 3].map(|g| chunk[g.min(last)] as usize);
+            let recs = id.map(|i| &records[i]);
+            let groups = ShearGroups::<V>::new(recs);
+            let mut limits = ShearGroups::<V>::limits(recs);
+            let valid = if chunk.len() * 4 >= 32 { u32::MAX } else { (1u32 << (4 * chunk.len())) - 1 };
+            if shadow {
+                let mut open = valid;
+                for block in blocks {
+                    tests += u64::from(open.count_ones() / 4);
+                    let mut bits = groups.test(block, limits, |g| slots[id[g]].ray).mask.bits() & open;
+                    while bits != 0 {
+                        let g = bits.trailing_zeros() / 4;
+                        open &= !(0xF << (4 * g));
+                        bits &= !(0xF << (4 * g));
+                    }
+                    if open == 0 {
+                        break;
+                    }
+                }
+                for (g, &ray) in chunk.iter().enumerate() {
+                    if open >> (4 * g) & 0xF == 0 {
+                        *hot[ray as usize].limit_mut() = BLOCKED;
+                    }
+                }
+            } else {
+                let mut found = 0u32;
+                for (b, block) in blocks.iter().enumerate() {
+                    tests += chunk.len() as u64;
+                    let h = groups.test(block, limits, |g| slots[id[g]].ray);
+                    let mut bits = h.mask.bits() & valid;
+                    if bits == 0 {
+                        continue;
+                    }
+                    let (mut t, mut u, mut v) = ([0f32; 16], [0f32; 16], [0f32; 16]);
+                    h.t.write_to(&mut t[..V::LANES]);
+                    h.u.write_to(&mut u[..V::LANES]);
+                    h.v.write_to(&mut v[..V::LANES]);
+                    while bits != 0 {
+                        let lane = bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        let g = lane / 4;
+                        let tri = self.tri_ids[4 * (first + b) + lane % 4];
+                        let hit = Hit { t: t[lane], tri, u: u[lane], v: v[lane] };
+                        let slot = &mut slots[id[g]];
+                        if hit.beats(slot.hit) {
+                            slot.hit = Some(hit);
+                            found |= 1 << g;
+                            limits = V::select(V::Mask::from_bits(0xF << (4 * g)), V::splat(hit.t), limits);
+                        }
+                    }
+                }
+                while found != 0 {
+                    let g = found.trailing_zeros() as usize;
+                    found &= found - 1;
+                    let slot = &slots[id[g]];
+                    records[id[g]].set_tmax(slot.best_t());
+                    *hot[id[g]].limit_mut() = slot.reach();
+                }
+            }
+        }
+        tests
     }
 
     /// Tests up to four rays, packed into a temporary SoA packet, against the leaf's triangles; returns the
@@ -432,7 +596,7 @@ struct Stream<'a, F> {
     mbvh: &'a Mbvh,
     rays: &'a [Option<Ray>],
     shadow: bool,
-    ordered: bool,
+    options: StreamOptions,
     stats: &'a mut TraversalStats,
     emit: F,
 }
@@ -441,11 +605,11 @@ impl<F: FnMut(usize, &Hot, &Slot)> Kernel for Stream<'_, F> {
     type Output = ();
     #[inline(always)]
     fn run<V: Vf32>(self) {
-        let Self { mbvh, rays, shadow, ordered, stats, emit } = self;
+        let Self { mbvh, rays, shadow, options, stats, emit } = self;
         #[cfg(target_arch = "x86_64")]
         if V::LANES == 8 {
-            return mbvh.stream::<V, raylab_simd::sse::F32x4>(rays, shadow, ordered, stats, emit);
+            return mbvh.stream::<V, raylab_simd::sse::F32x4>(rays, shadow, options, stats, emit);
         }
-        mbvh.stream::<V, V>(rays, shadow, ordered, stats, emit)
+        mbvh.stream::<V, V>(rays, shadow, options, stats, emit)
     }
 }

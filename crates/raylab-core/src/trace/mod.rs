@@ -19,7 +19,7 @@ use crate::dacrt::{Dacrt, DacrtParams};
 use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
 use crate::kdtree::packet::PacketStack;
-use crate::mbvh::Mbvh;
+use crate::mbvh::{Mbvh, StreamLeaves, StreamOptions};
 use crate::method::Method;
 use crate::packet::Cone;
 use crate::packet::{Frustum, PacketTile, RayPacket, map3};
@@ -47,6 +47,8 @@ pub struct TraceOptions {
     /// Order MBVH RS child tasks by accumulated hit length (the paper's heuristic; off walks them in lane
     /// order, to measure its gain).
     pub stream_order: bool,
+    /// How MBVH RS tests the rays reaching a leaf: the paper's ray packets or ray/triangle-block tests.
+    pub stream_leaves: StreamLeaves,
     /// DACRT's leaf thresholds and split rule.
     pub dacrt: DacrtParams,
     /// MBVH RS ray-group size: `None` traces each tile as one group; `Some(g)` cuts a tile into groups of `g`
@@ -72,6 +74,7 @@ impl Default for TraceOptions {
             backend: Backend::detect(),
             shadow_spread_limit: Self::SHADOW_SPREAD_LIMIT,
             stream_order: true,
+            stream_leaves: StreamLeaves::default(),
             dacrt: DacrtParams::default(),
             stream_group: None,
         }
@@ -114,6 +117,10 @@ impl<'a> Tracer<'a> {
 
     fn mbvh(&self) -> &'a Mbvh {
         self.mbvh.expect("the mbvh method needs an Mbvh (Tracer::with_mbvh)")
+    }
+
+    fn stream_options(&self) -> StreamOptions {
+        StreamOptions { ordered: self.options.stream_order, leaves: self.options.stream_leaves }
     }
 
     /// The same tracer with another traversal method (the brute-force reference stays the reference).
@@ -277,7 +284,7 @@ impl<'a> Tracer<'a> {
                 }
             }
             Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
-                self.mbvh().intersect_stream(r, o, self.options.stream_order, stats)
+                self.mbvh().intersect_stream(r, o, self.stream_options(), stats)
             }),
             Method::Dacrt => self.dacrt().intersect(&self.options.dacrt, rays, out, stats),
             _ => raylab_simd::dispatch(
@@ -317,7 +324,7 @@ impl<'a> Tracer<'a> {
                 }
             }
             Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
-                self.mbvh().occluded_stream(r, o, self.options.stream_order, stats)
+                self.mbvh().occluded_stream(r, o, self.stream_options(), stats)
             }),
             Method::Dacrt => self.dacrt().occluded(&self.options.dacrt, rays, out, stats),
             _ => raylab_simd::dispatch(

@@ -2,6 +2,7 @@
 //! view), with the readouts below.
 
 use raylab_core::dacrt::{DacrtParams, SplitRule};
+use raylab_core::mbvh::StreamLeaves;
 use raylab_core::method::Method;
 use raylab_core::render::{FrameView, RayOrder};
 use raylab_simd::Backend;
@@ -213,6 +214,16 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
         )
         .on_hover_text("walk MBVH RS children by accumulated hit length (the paper's heuristic)")
         .on_disabled_hover_text("only mbvh-rs orders its child tasks");
+        ui.add_enabled_ui(s.trace.method == Method::MbvhRs, |ui| {
+            egui::ComboBox::from_label("stream leaves").selected_text(s.trace.stream_leaves.name()).show_ui(ui, |ui| {
+                for l in StreamLeaves::ALL {
+                    ui.selectable_value(&mut s.trace.stream_leaves, l, l.name());
+                }
+            });
+        })
+        .response
+        .on_hover_text("MBVH RS leaf test: ray pairs against four-triangle blocks, or the paper's four-ray packets")
+        .on_disabled_hover_text("only mbvh-rs streams rays through leaves");
         if s.trace.method.uses_dacrt() {
             dacrt_controls(ui, s);
         }
