@@ -194,23 +194,30 @@ impl<V: Vf32> ShearX4<V> {
     }
 }
 
-/// A ray's watertight-test constants as two rows of four floats, so that a group of four lanes loads them
-/// with one broadcast each: the origin in the shear's `(kx, ky, kz)` order and `tmin`, then `(S_x, S_y, S_z)`
-/// and the far limit; and the axes. Computed once per ray of an MBVH ray stream, whose rays reach many
-/// leaves ([`ShearGroups`]).
+/// A ray's leaf-test state in 48 bytes: its watertight-test constants as two rows of four floats, so that a
+/// group of four lanes loads them with one broadcast each (the origin in the shear's `(kx, ky, kz)` order and
+/// `tmin`, then `(S_x, S_y, S_z)` and the far limit: `tmax`, then the closest hit's distance), the axes, and
+/// the closest hit's triangle, so that a closest-hit test decides [`Hit::beats`] from the record alone.
+/// Computed once per ray of an MBVH ray stream, whose rays reach many leaves ([`ShearGroups`]).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
 pub struct ShearRecord {
     rows: [[f32; 4]; 2],
-    axes: [usize; 3],
+    axes: [u32; 3],
+    best: u32,
 }
 
 impl ShearRecord {
-    /// The constants of `ray` (its direction must not be zero), with its own `tmax` as the far limit.
+    /// The constants of `ray` (its direction must not be zero), with its own `tmax` as the far limit and no
+    /// hit yet.
     pub fn new(ray: &Ray) -> Self {
         let shear = RayShear::new(ray);
         let (axes, o, s) = (shear.axes(), shear.origin().to_array(), shear.shear());
-        Self { rows: [[o[axes[0]], o[axes[1]], o[axes[2]], ray.tmin], [s[0], s[1], s[2], ray.tmax]], axes }
+        Self {
+            rows: [[o[axes[0]], o[axes[1]], o[axes[2]], ray.tmin], [s[0], s[1], s[2], ray.tmax]],
+            axes: axes.map(|a| a as u32),
+            best: u32::MAX,
+        }
     }
 
     /// The far limit hits must not pass (`tmax`, or the closest hit so far).
@@ -218,9 +225,19 @@ impl ShearRecord {
         self.rows[1][3]
     }
 
-    /// Sets the far limit.
-    pub fn set_tmax(&mut self, t: f32) {
+    /// True when a hit on triangle `tri` at `t` (found within the far limit) beats the closest so far, by
+    /// [`Hit::beats`]'s rule: nearer, or as near on a lower triangle id. Any hit beats none (at most `tmax`
+    /// away, with an id below `u32::MAX`, which no triangle has).
+    #[inline(always)]
+    pub fn beaten_by(&self, t: f32, tri: u32) -> bool {
+        t < self.tmax() || (t == self.tmax() && tri < self.best)
+    }
+
+    /// Records a closest hit: its distance becomes the far limit.
+    #[inline(always)]
+    pub fn set_best(&mut self, t: f32, tri: u32) {
         self.rows[1][3] = t;
+        self.best = tri;
     }
 }
 
@@ -234,7 +251,7 @@ pub struct ShearGroups<V: Vf32> {
     org: [V; 3],
     s: [V; 3],
     tmin: V,
-    axes: [[usize; 3]; 4],
+    axes: [[u32; 3]; 4],
 }
 
 impl<V: Vf32> ShearGroups<V> {
@@ -256,7 +273,8 @@ impl<V: Vf32> ShearGroups<V> {
     #[inline(always)]
     fn corner(&self, b: &Tri4, c: usize) -> (V, V, V) {
         let a = &self.axes;
-        let pick = |i: usize| V::from_quads(&[&b.v[c][a[0][i]], &b.v[c][a[1][i]], &b.v[c][a[2][i]], &b.v[c][a[3][i]]]);
+        let at = |g: usize, i: usize| &b.v[c][a[g][i] as usize];
+        let pick = |i: usize| V::from_quads(&[at(0, i), at(1, i), at(2, i), at(3, i)]);
         (pick(0) - self.org[0], pick(1) - self.org[1], pick(2) - self.org[2])
     }
 

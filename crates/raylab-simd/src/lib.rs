@@ -100,6 +100,20 @@ pub trait Vf32:
     /// Each group of four lanes transposed as a 4x4 matrix: lane `4g + j` of result `i` is lane `4g + i` of
     /// `rows[j]` (the per-ray results of four-wide node tests regrouped per node lane, in MBVH ray streams).
     fn transpose4(rows: [Self; 4]) -> [Self; 4];
+    /// `ids` (at least `LANES` of them) in the lane order of [`Vf32::transpose4`]'s results: lane `i` holds
+    /// `ids[(LANES / 4) * (i % 4) + i / 4]`. When row `j` of `transpose4`'s input holds the results of ids
+    /// `(LANES / 4) * j ..`, one per group of four lanes, lane `i` of every output row then belongs to id `i`
+    /// of this array (MBVH ray streams regroup two rays' node tests per child, then push the rays by
+    /// [`Vf32::pack_u32`]).
+    #[inline(always)]
+    fn transpose4_ids(ids: &[u32]) -> Self::Array<u32> {
+        let per = Self::LANES / 4;
+        let mut out = Self::array_from_fn(|_| 0);
+        for (i, slot) in out.as_mut().iter_mut().enumerate() {
+            *slot = ids[per * (i % 4) + i / 4];
+        }
+        out
+    }
     /// Left-packs `ids`: writes the entries whose bit is set in `bits` (entry `i` in bit `i`) to the front of
     /// `out` in order and returns how many there are, with one whole-vector store and no branch per entry
     /// (MBVH ray streams push a vector of rays onto a lane's stack at once). `out` must hold at least `LANES`
@@ -373,6 +387,10 @@ mod tests {
                 for i in 0..n {
                     assert_eq!(col.lane(i), (100 * (i % 4) + i - i % 4 + c) as f32, "transpose4 lane {i} of {c}");
                 }
+            }
+            let regrouped = V::transpose4_ids(&(0..n as u32).collect::<Vec<_>>());
+            for (i, &id) in regrouped.as_ref().iter().enumerate() {
+                assert_eq!(id as usize, (n / 4) * (i % 4) + i / 4, "transpose4_ids lane {i}");
             }
             let ids = V::array_from_fn(|i| 7 + i as u32);
             for bits in [0u32, 1, 0b1010, 0b0110_1001, u32::MAX, 1 << (n - 1)] {

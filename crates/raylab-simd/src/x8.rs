@@ -218,6 +218,19 @@ impl Vf32 for F32x8 {
         })
     }
     #[inline(always)]
+    fn transpose4_ids(ids: &[u32]) -> [u32; 8] {
+        let ids: &[u32; 8] = ids[..8].try_into().expect("eight ids");
+        let mut out = [0u32; 8];
+        // SAFETY: `ids` and `out` are eight `u32`s each and `loadu`/`storeu` have no alignment requirement;
+        // AVX2 is present (see `avx!`).
+        unsafe {
+            let v = _mm256_loadu_si256(ids.as_ptr().cast());
+            let order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+            _mm256_storeu_si256(out.as_mut_ptr().cast(), _mm256_permutevar8x32_epi32(v, order));
+        }
+        out
+    }
+    #[inline(always)]
     fn pack_u32(ids: &[u32; 8], bits: u32, out: &mut [u32]) -> usize {
         assert!(out.len() >= 8);
         let keep = (bits & 0xff) as usize;

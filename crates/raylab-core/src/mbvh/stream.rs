@@ -247,24 +247,15 @@ impl Mbvh {
         let blocks = options.leaves == StreamLeaves::Blocks;
         assert_eq!(V::LANES, 4, "MBVH RS packs leaf rays four at a time");
         assert!(B::LANES == 4 || B::LANES == 8, "one or two rays per box test");
+        // Every position gets a ray (`None` a placeholder) and state; only valid rays enter the walk.
+        let ray = |r: &Option<Ray>| r.unwrap_or(Ray::new(glam::Vec3::ZERO, glam::Vec3::Z));
         let mut state = StreamRays {
-            hot: Vec::with_capacity(rays.len()),
-            slots: Vec::with_capacity(rays.len()),
-            records: Vec::with_capacity(if blocks { rays.len() } else { 0 }),
+            hot: rays.iter().map(|r| Hot::new(&ray(r))).collect(),
+            slots: rays.iter().map(|r| Slot { ray: ray(r), hit: None }).collect(),
+            records: if blocks { rays.iter().map(|r| ShearRecord::new(&ray(r))).collect() } else { Vec::new() },
         };
-        let mut ids: Vec<u32> = Vec::with_capacity(rays.len());
-        for (i, r) in rays.iter().enumerate() {
-            let ray = r.unwrap_or(Ray::new(glam::Vec3::ZERO, glam::Vec3::Z));
-            let live = r.is_some_and(|r| r.is_valid());
-            state.hot.push(Hot::new(&ray));
-            if blocks {
-                state.records.push(ShearRecord::new(&ray));
-            }
-            state.slots.push(Slot { ray, hit: None });
-            if live {
-                ids.push(i as u32);
-            }
-        }
+        let ids: Vec<u32> =
+            (0..rays.len() as u32).filter(|&i| rays[i as usize].is_some_and(|r| r.is_valid())).collect();
         stats.rays += ids.len() as u64;
         stats.packets += ids.len().div_ceil(4) as u64;
         if !self.tri_ids.is_empty() && !ids.is_empty() {
@@ -357,24 +348,30 @@ impl Mbvh {
                 let rem = (end - r).min(B::LANES);
                 let ids = &stacks[lane][r..r + B::LANES];
                 // After the transpose, lane `4g + p` of a child's flags is ray `per_test * p + g`'s: the ids in
-                // that order, for the packing. (Loops rather than `array::from_fn`, whose closures would be
-                // compiled outside the SIMD entry point.)
-                let mut order = B::array_from_fn(|_| 0);
-                for (i, slot) in order.as_mut().iter_mut().enumerate() {
-                    *slot = ids[per_test * (i % 4) + i / 4];
-                }
+                // that order, for the packing.
+                let order = B::transpose4_ids(ids);
                 let mut flags = [zero; 4];
-                for (p, flags) in flags.iter_mut().enumerate().take(rem.div_ceil(per_test)) {
-                    let a = per_test * p;
-                    // A chunk's odd last ray, when two share a test, is tested twice and the copy's hits are
-                    // masked off.
-                    let second = ids[(a + 1).min(rem - 1)];
-                    let (near, mut hit) = test_boxes::<B>(node, [&hot[ids[a] as usize], &hot[second as usize]]);
-                    if a + per_test > rem {
-                        hit = hit & B::Mask::from_bits(0xF);
+                if rem == B::LANES {
+                    for (p, flags) in flags.iter_mut().enumerate() {
+                        let a = per_test * p;
+                        let (near, hit) =
+                            test_boxes::<B>(node, [&hot[ids[a] as usize], &hot[ids[a + per_test - 1] as usize]]);
+                        lengths = lengths + B::select(hit, near, zero);
+                        *flags = B::select(hit, flag, zero);
                     }
-                    lengths = lengths + B::select(hit, near, zero);
-                    *flags = B::select(hit, flag, zero);
+                } else {
+                    for (p, flags) in flags.iter_mut().enumerate().take(rem.div_ceil(per_test)) {
+                        let a = per_test * p;
+                        // A chunk's odd last ray, when two share a test, is tested twice and the copy's hits are
+                        // masked off.
+                        let second = ids[(a + 1).min(rem - 1)];
+                        let (near, mut hit) = test_boxes::<B>(node, [&hot[ids[a] as usize], &hot[second as usize]]);
+                        if a + per_test > rem {
+                            hit = hit & B::Mask::from_bits(0xF);
+                        }
+                        lengths = lengths + B::select(hit, near, zero);
+                        *flags = B::select(hit, flag, zero);
+                    }
                 }
                 for ((stack, top), hits) in stacks.iter_mut().zip(&mut tops).zip(B::transpose4(flags)) {
                     *top += B::pack_u32(&order, hits.lt(zero).bits(), &mut stack[*top..]);
@@ -511,21 +508,19 @@ impl Mbvh {
                         bits &= bits - 1;
                         let g = lane / 4;
                         let tri = self.tri_ids[4 * (first + b) + lane % 4];
-                        let hit = Hit { t: t[lane], tri, u: u[lane], v: v[lane] };
-                        let slot = &mut slots[id[g]];
-                        if hit.beats(slot.hit) {
-                            slot.hit = Some(hit);
+                        let record = &mut records[id[g]];
+                        if record.beaten_by(t[lane], tri) {
+                            record.set_best(t[lane], tri);
+                            slots[id[g]].hit = Some(Hit { t: t[lane], tri, u: u[lane], v: v[lane] });
                             found |= 1 << g;
-                            limits = V::select(V::Mask::from_bits(0xF << (4 * g)), V::splat(hit.t), limits);
+                            limits = V::select(V::Mask::from_bits(0xF << (4 * g)), V::splat(t[lane]), limits);
                         }
                     }
                 }
                 while found != 0 {
                     let g = found.trailing_zeros() as usize;
                     found &= found - 1;
-                    let slot = &slots[id[g]];
-                    records[id[g]].set_tmax(slot.best_t());
-                    *hot[id[g]].limit_mut() = slot.reach();
+                    *hot[id[g]].limit_mut() = hit_reach(records[id[g]].tmax());
                 }
             }
         }
