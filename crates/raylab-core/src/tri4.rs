@@ -285,35 +285,36 @@ impl<V: Vf32> ShearGroups<V> {
     pub fn test(&self, b: &Tri4, tmax: V, ray: impl Fn(usize) -> Ray) -> BlockHits<V> {
         let corners = [self.corner(b, 0), self.corner(b, 1), self.corner(b, 2)];
         let lanes = sheared_test(corners, self.s, self.tmin, tmax);
-        let hits = BlockHits { mask: lanes.hit, t: lanes.t, u: lanes.u, v: lanes.v };
-        if lanes.exact_zero.none() { hits } else { Self::redo(b, hits, lanes.exact_zero.bits(), tmax, ray) }
-    }
-
-    /// Rare: lanes with an exactly zero edge function, which the scalar test decides in double precision.
-    #[cold]
-    fn redo(b: &Tri4, hits: BlockHits<V>, lanes: u32, tmax: V, ray: impl Fn(usize) -> Ray) -> BlockHits<V> {
-        let (mut t, mut u, mut v) = ([0f32; 16], [0f32; 16], [0f32; 16]);
+        if lanes.exact_zero.none() {
+            return BlockHits { mask: lanes.hit, t: lanes.t, u: lanes.u, v: lanes.v };
+        }
+        // The vectors go through arrays, so that the cold scalar redo holds no vector code (which, out of
+        // line, would be built without the entry point's instruction set).
         let n = V::LANES;
-        hits.t.write_to(&mut t[..n]);
-        hits.u.write_to(&mut u[..n]);
-        hits.v.write_to(&mut v[..n]);
-        let mut bits = hits.mask.bits();
-        for lane in (0..n).filter(|i| lanes >> i & 1 == 1) {
-            let ray = ray(lane / 4);
-            let tri = b.triangle(lane % 4);
-            if let Some(TriHit { t: ht, u: hu, v: hv }) = RayShear::new(&ray).intersect(&tri, ray.tmin, tmax.lane(lane))
-            {
-                (t[lane], u[lane], v[lane]) = (ht, hu, hv);
-                bits |= 1 << lane;
-            }
+        let (mut limits, mut out) = ([0f32; 16], [[0f32; 16]; 3]);
+        tmax.write_to(&mut limits[..n]);
+        for (array, lane_values) in out.iter_mut().zip([lanes.t, lanes.u, lanes.v]) {
+            lane_values.write_to(&mut array[..n]);
         }
-        BlockHits {
-            mask: V::Mask::from_bits(bits),
-            t: V::from_slice(&t[..n]),
-            u: V::from_slice(&u[..n]),
-            v: V::from_slice(&v[..n]),
+        let bits = redo(b, lanes.hit.bits(), lanes.exact_zero.bits(), &limits[..n], &mut out, ray);
+        let [t, u, v] = out.map(|a| V::from_slice(&a[..n]));
+        BlockHits { mask: V::Mask::from_bits(bits), t, u, v }
+    }
+}
+
+/// Rare: the lanes in `zero` have an exactly zero edge function, which the scalar test decides in double
+/// precision. Lane `i` tests group `i / 4`'s ray against triangle `i % 4` of `b` up to `tmax[i]`; `out` holds
+/// the lanes' distances and barycentrics and `hit` the lanes hit so far. Returns the lanes hit.
+#[cold]
+fn redo(b: &Tri4, mut hit: u32, zero: u32, tmax: &[f32], out: &mut [[f32; 16]; 3], ray: impl Fn(usize) -> Ray) -> u32 {
+    for lane in (0..tmax.len()).filter(|i| zero >> i & 1 == 1) {
+        let ray = ray(lane / 4);
+        if let Some(TriHit { t, u, v }) = RayShear::new(&ray).intersect(&b.triangle(lane % 4), ray.tmin, tmax[lane]) {
+            (out[0][lane], out[1][lane], out[2][lane]) = (t, u, v);
+            hit |= 1 << lane;
         }
     }
+    hit
 }
 
 #[cfg(test)]
