@@ -165,6 +165,32 @@ pub fn prefetch<T>(values: &[T]) {
     let _ = values;
 }
 
+/// Asks the kernel to back the 2 MiB-aligned stretches of `values` with huge pages (Linux transparent huge
+/// pages: `MADV_HUGEPAGE`, then `MADV_COLLAPSE` for memory already touched). A hint only: it changes no value
+/// and does nothing elsewhere, on slices without a whole aligned stretch, or where the kernel declines.
+/// With 4 KiB pages the physical placement of a structure that fills much of the L2 cache (an MBVH ray
+/// stream's per-ray records, about 0.5 MiB for 2^12 rays) differs from run to run, and with it the cache
+/// conflicts: on Zen 5 the same stream traced 1.3x faster in some processes than in others.
+pub fn huge_pages<T>(values: &[T]) {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        const HUGE: usize = 2 << 20;
+        let start = values.as_ptr() as usize;
+        let (first, end) = (start.next_multiple_of(HUGE), start + std::mem::size_of_val(values));
+        if end >= first + HUGE {
+            let len = (end - first) / HUGE * HUGE;
+            // SAFETY: the range lies inside `values`' allocation and `madvise` with these advice values changes
+            // how pages are backed, never their contents; a failure is only an error code, ignored here.
+            unsafe {
+                libc::madvise(first as *mut libc::c_void, len, libc::MADV_HUGEPAGE);
+                libc::madvise(first as *mut libc::c_void, len, libc::MADV_COLLAPSE);
+            }
+        }
+    }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    let _ = values;
+}
+
 /// Which hardware path the kernels use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Backend {
@@ -416,6 +442,15 @@ mod tests {
         for b in Backend::available() {
             dispatch(b, Semantics);
         }
+    }
+
+    #[test]
+    fn huge_page_advice_keeps_every_value() {
+        let values: Vec<u32> = (0..3 << 20).collect();
+        huge_pages(&values);
+        huge_pages(&values[5..7]);
+        huge_pages::<u64>(&[]);
+        assert!(values.iter().enumerate().all(|(i, &v)| v == i as u32));
     }
 
     #[test]
