@@ -19,7 +19,7 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 use rayon::prelude::*;
 
-use crate::packet::sheared_test;
+use crate::packet::{Sheared, sheared_test};
 use crate::ray::{Hit, Ray};
 use crate::triangle::{RayShear, TriHit, TriangleSoup};
 
@@ -172,26 +172,53 @@ impl<V: Vf32> ShearX4<V> {
     pub fn test(&self, b: &Tri4, tmin: f32, tmax: f32) -> BlockHits<V> {
         let corners = [self.corner(b, 0), self.corner(b, 1), self.corner(b, 2)];
         let lanes = sheared_test(corners, self.s, V::splat(tmin), V::splat(tmax));
-        let hits = BlockHits { mask: lanes.hit, t: lanes.t, u: lanes.u, v: lanes.v };
-        if lanes.exact_zero.none() { hits } else { self.redo(b, hits, lanes.exact_zero.bits(), tmin, tmax) }
+        with_exact_zeros_redone(lanes, V::splat(tmax), |lane, tmax| {
+            self.scalar.intersect(&b.triangle(lane), tmin, tmax)
+        })
     }
+}
 
-    /// Rare: lanes with an exactly zero edge function, which the scalar test decides in double precision.
-    #[cold]
-    fn redo(&self, b: &Tri4, hits: BlockHits<V>, lanes: u32, tmin: f32, tmax: f32) -> BlockHits<V> {
-        let (mut t, mut u, mut v) = ([0f32; 4], [0f32; 4], [0f32; 4]);
-        hits.t.write_to(&mut t);
-        hits.u.write_to(&mut u);
-        hits.v.write_to(&mut v);
-        let mut bits = hits.mask.bits();
-        for lane in (0..4).filter(|i| lanes >> i & 1 == 1) {
-            if let Some(TriHit { t: ht, u: hu, v: hv }) = self.scalar.intersect(&b.triangle(lane), tmin, tmax) {
-                (t[lane], u[lane], v[lane]) = (ht, hu, hv);
-                bits |= 1 << lane;
-            }
-        }
-        BlockHits { mask: V::Mask::from_bits(bits), t: V::from_slice(&t), u: V::from_slice(&u), v: V::from_slice(&v) }
+/// The lanes of a block test, with those whose edge functions came out exactly zero decided by `scalar(lane,
+/// tmax)` (the scalar test, which recomputes them in double precision), as the block tests of [`ShearX4`] and
+/// [`ShearGroups`] do. The vectors go through arrays, so that the cold redo holds no vector code (which, out
+/// of line, would be built without the SIMD entry point's instruction set).
+#[inline(always)]
+fn with_exact_zeros_redone<V: Vf32>(
+    lanes: Sheared<V>,
+    tmax: V,
+    scalar: impl Fn(usize, f32) -> Option<TriHit>,
+) -> BlockHits<V> {
+    if lanes.exact_zero.none() {
+        return BlockHits { mask: lanes.hit, t: lanes.t, u: lanes.u, v: lanes.v };
     }
+    let n = V::LANES;
+    let (mut limits, mut out) = ([0f32; 16], [[0f32; 16]; 3]);
+    tmax.write_to(&mut limits[..n]);
+    for (array, lane_values) in out.iter_mut().zip([lanes.t, lanes.u, lanes.v]) {
+        lane_values.write_to(&mut array[..n]);
+    }
+    let bits = redo(lanes.hit.bits(), lanes.exact_zero.bits(), &limits[..n], &mut out, scalar);
+    let [t, u, v] = out.map(|a| V::from_slice(&a[..n]));
+    BlockHits { mask: V::Mask::from_bits(bits), t, u, v }
+}
+
+/// Rare: the lanes in `zero` have an exactly zero edge function. `scalar(lane, tmax[lane])` decides each;
+/// `out` holds the lanes' distances and barycentrics and `hit` the lanes hit so far. Returns the lanes hit.
+#[cold]
+fn redo(
+    mut hit: u32,
+    zero: u32,
+    tmax: &[f32],
+    out: &mut [[f32; 16]; 3],
+    scalar: impl Fn(usize, f32) -> Option<TriHit>,
+) -> u32 {
+    for lane in (0..tmax.len()).filter(|i| zero >> i & 1 == 1) {
+        if let Some(TriHit { t, u, v }) = scalar(lane, tmax[lane]) {
+            (out[0][lane], out[1][lane], out[2][lane]) = (t, u, v);
+            hit |= 1 << lane;
+        }
+    }
+    hit
 }
 
 /// A ray's leaf-test state in 48 bytes: its watertight-test constants as two rows of four floats, so that a
@@ -285,36 +312,11 @@ impl<V: Vf32> ShearGroups<V> {
     pub fn test(&self, b: &Tri4, tmax: V, ray: impl Fn(usize) -> Ray) -> BlockHits<V> {
         let corners = [self.corner(b, 0), self.corner(b, 1), self.corner(b, 2)];
         let lanes = sheared_test(corners, self.s, self.tmin, tmax);
-        if lanes.exact_zero.none() {
-            return BlockHits { mask: lanes.hit, t: lanes.t, u: lanes.u, v: lanes.v };
-        }
-        // The vectors go through arrays, so that the cold scalar redo holds no vector code (which, out of
-        // line, would be built without the entry point's instruction set).
-        let n = V::LANES;
-        let (mut limits, mut out) = ([0f32; 16], [[0f32; 16]; 3]);
-        tmax.write_to(&mut limits[..n]);
-        for (array, lane_values) in out.iter_mut().zip([lanes.t, lanes.u, lanes.v]) {
-            lane_values.write_to(&mut array[..n]);
-        }
-        let bits = redo(b, lanes.hit.bits(), lanes.exact_zero.bits(), &limits[..n], &mut out, ray);
-        let [t, u, v] = out.map(|a| V::from_slice(&a[..n]));
-        BlockHits { mask: V::Mask::from_bits(bits), t, u, v }
+        with_exact_zeros_redone(lanes, tmax, |lane, tmax| {
+            let ray = ray(lane / 4);
+            RayShear::new(&ray).intersect(&b.triangle(lane % 4), ray.tmin, tmax)
+        })
     }
-}
-
-/// Rare: the lanes in `zero` have an exactly zero edge function, which the scalar test decides in double
-/// precision. Lane `i` tests group `i / 4`'s ray against triangle `i % 4` of `b` up to `tmax[i]`; `out` holds
-/// the lanes' distances and barycentrics and `hit` the lanes hit so far. Returns the lanes hit.
-#[cold]
-fn redo(b: &Tri4, mut hit: u32, zero: u32, tmax: &[f32], out: &mut [[f32; 16]; 3], ray: impl Fn(usize) -> Ray) -> u32 {
-    for lane in (0..tmax.len()).filter(|i| zero >> i & 1 == 1) {
-        let ray = ray(lane / 4);
-        if let Some(TriHit { t, u, v }) = RayShear::new(&ray).intersect(&b.triangle(lane % 4), ray.tmin, tmax[lane]) {
-            (out[0][lane], out[1][lane], out[2][lane]) = (t, u, v);
-            hit |= 1 << lane;
-        }
-    }
-    hit
 }
 
 #[cfg(test)]

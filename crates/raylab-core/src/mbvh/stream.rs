@@ -290,7 +290,7 @@ impl Mbvh {
         let mut state = StreamRays {
             hot: aligned(&mut scratch.hot, n, Hot::new(&placeholder)),
             slots: aligned(&mut scratch.slots, n, Slot { ray: placeholder, hit: None }),
-            records: aligned(&mut scratch.records, if blocks { n } else { 0 }, ShearRecord::new(&placeholder)),
+            records: if blocks { aligned(&mut scratch.records, n, ShearRecord::new(&placeholder)) } else { &mut [] },
         };
         for (i, r) in rays.iter().enumerate() {
             let ray = r.unwrap_or(placeholder);
@@ -517,7 +517,7 @@ impl Mbvh {
             let recs = id.map(|i| &records[i]);
             let groups = ShearGroups::<V>::new(recs);
             let mut limits = ShearGroups::<V>::limits(recs);
-            let valid = if chunk.len() * 4 >= 32 { u32::MAX } else { (1u32 << (4 * chunk.len())) - 1 };
+            let valid = (1u32 << (4 * chunk.len())) - 1;
             if shadow {
                 let mut open = valid;
                 for block in blocks {

@@ -16,7 +16,7 @@ pub use batch_cull::BatchCull;
 pub use cone::Cone;
 pub use disc::Disc;
 pub use tile::{Bundle, Frustum, PacketTile, overlaps_box, packet_shape, slab_interval};
-pub(crate) use woop::{crossing_packet, sheared_test};
+pub(crate) use woop::{Sheared, crossing_packet, sheared_test};
 pub use woop::{intersect_packet, occlude_packet};
 
 /// Most lanes a packet may have (16, for AVX-512).
