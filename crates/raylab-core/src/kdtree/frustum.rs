@@ -61,18 +61,41 @@ impl<const SLOTS: usize> Default for BatchBits<SLOTS> {
 }
 
 impl<const SLOTS: usize> BatchBits<SLOTS> {
-    /// False when packet `j` of `tile` certainly has no ray inside `bounds` before its current hits; true
-    /// when it may, or when the tile has no batch data.
+    /// Bits (lane `i` for packet `chunk * LANES + i`) of the packets of `tile`'s chunk `chunk` that may have a
+    /// ray inside `bounds` before their current hits: all of them when the tile has no batch data.
     #[inline(always)]
-    fn may_enter<V: Vf32>(&mut self, tile: &PacketTile<V>, j: usize, bounds: &Aabb) -> bool {
-        let Some(batch) = &tile.batch else { return true };
-        let chunk = j / V::LANES;
+    fn may_enter<V: Vf32>(&mut self, tile: &PacketTile<V>, chunk: usize, bounds: &Aabb) -> u32 {
+        let Some(batch) = &tile.batch else { return u32::MAX };
         let slot = chunk % SLOTS;
         if self.chunk[slot] != chunk {
             self.chunk[slot] = chunk;
             self.bits[slot] = batch.maybe_inside::<V>(chunk, bounds, &tile.farthest_hit, SPLIT_SLACK);
         }
-        self.bits[slot] >> (j % V::LANES) & 1 == 1
+        self.bits[slot]
+    }
+}
+
+/// A set of a tile's packets as one bit mask per chunk of [`Vf32::LANES`] packets (the chunks of
+/// [`crate::packet::BatchCull`]), so a leaf test checks a whole chunk's packets with a few vector and bit
+/// operations and visits only those left: at most leaves, most of a frustum's packets are culled (Table 4.2).
+pub(super) struct ChunkSet {
+    /// `(chunk, members)`: bit `i` of `members` for packet `chunk * LANES + i`, in the order the set first
+    /// names each chunk.
+    chunks: Vec<(usize, u32)>,
+}
+
+impl ChunkSet {
+    /// The chunks of packets `set` for lane type `V`.
+    pub fn new<V: Vf32>(set: &[usize]) -> Self {
+        let mut chunks: Vec<(usize, u32)> = Vec::new();
+        for &j in set {
+            let (chunk, bit) = (j / V::LANES, 1u32 << (j % V::LANES));
+            match chunks.iter_mut().rev().find(|(c, _)| *c == chunk) {
+                Some((_, members)) => *members |= bit,
+                None => chunks.push((chunk, bit)),
+            }
+        }
+        Self { chunks }
     }
 }
 
@@ -82,7 +105,7 @@ impl<const SLOTS: usize> BatchBits<SLOTS> {
 pub(super) fn leaf_intersect<V: Vf32, const SLOTS: usize>(
     leaf: &Leaf,
     tile: &mut PacketTile<V>,
-    set: &[usize],
+    set: &ChunkSet,
     cull: bool,
     batch: &mut BatchBits<SLOTS>,
     stats: &mut TraversalStats,
@@ -95,18 +118,44 @@ pub(super) fn leaf_intersect<V: Vf32, const SLOTS: usize>(
     let bounds = &tree.leaf_bounds(leaf.node);
     let mut changed = false;
     let done_before = leaf.near * (1.0 - SPLIT_SLACK);
-    for &j in set {
-        // A packet whose rays all hit before the leaf starts: nothing here can be closer.
-        if tile.farthest_hit[j] < done_before || (cull && !batch.may_enter(tile, j, bounds)) {
-            stats.packets_culled += 1;
-            continue;
+    for &(chunk, members) in &set.chunks {
+        // Packets whose rays all hit before the leaf starts (nothing here can be closer), then those whose rays
+        // certainly miss its box, leave the chunk's bits.
+        let first = chunk * V::LANES;
+        let farthest = V::from_slice(&tile.farthest_hit[first..first + V::LANES]);
+        let mut left = members & !farthest.lt(V::splat(done_before)).bits();
+        if cull && left != 0 {
+            left &= batch.may_enter(tile, chunk, bounds);
         }
+        stats.packets_culled += (members & !left).count_ones() as u64;
+        while left != 0 {
+            let j = first + left.trailing_zeros() as usize;
+            left &= left - 1;
+            changed |= packet_intersect(tree, ids, bounds, tile, j, cull, stats);
+        }
+    }
+    changed
+}
+
+/// [`leaf_intersect`] for packet `j`, which the chunk tests kept: culls it against the leaf box `bounds` ray by
+/// ray (when `cull` is on), then tests triangles `ids`. Returns true when some lane's closest hit changed.
+#[inline(always)]
+fn packet_intersect<V: Vf32>(
+    tree: &KdTree,
+    ids: &[u32],
+    bounds: &Aabb,
+    tile: &mut PacketTile<V>,
+    j: usize,
+    cull: bool,
+    stats: &mut TraversalStats,
+) -> bool {
+    {
         let p = &tile.packets[j];
         let hits = &mut tile.hits[j];
         let active = if cull { overlaps_box(p, bounds, hit_reach_lanes(hits.t), SPLIT_SLACK) } else { p.valid };
         if active.none() {
             stats.packets_culled += 1;
-            continue;
+            return false;
         }
         stats.packets_tested += 1;
         let mut packet_changed = false;
@@ -116,10 +165,9 @@ pub(super) fn leaf_intersect<V: Vf32, const SLOTS: usize>(
         }
         if packet_changed {
             tile.farthest_hit[j] = hit_reach(V::select(p.valid, hits.t, V::splat(f32::NEG_INFINITY)).reduce_max());
-            changed = true;
         }
+        packet_changed
     }
-    changed
 }
 
 /// Any-hit counterpart of [`leaf_intersect`]: marks lanes blocked by the leaf's triangles in `blocked`.
@@ -128,7 +176,7 @@ pub(super) fn leaf_intersect<V: Vf32, const SLOTS: usize>(
 pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
     leaf: &Leaf,
     tile: &PacketTile<V>,
-    set: &[usize],
+    set: &ChunkSet,
     cull: bool,
     batch: &mut BatchBits<SLOTS>,
     blocked: &mut [V::Mask],
@@ -141,33 +189,39 @@ pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
     }
     let bounds = &tree.leaf_bounds(leaf.node);
     let mut finished = 0;
-    for &j in set {
-        let p = &tile.packets[j];
-        let mut open = p.valid & !blocked[j];
-        if open.none() {
-            continue;
-        }
-        if cull {
-            if !batch.may_enter(tile, j, bounds) {
-                stats.packets_culled += 1;
+    for &(chunk, members) in &set.chunks {
+        let mut bits = members;
+        while bits != 0 {
+            let lane = bits.trailing_zeros();
+            bits &= bits - 1;
+            let j = chunk * V::LANES + lane as usize;
+            let p = &tile.packets[j];
+            let mut open = p.valid & !blocked[j];
+            if open.none() {
                 continue;
             }
-            open = open & overlaps_box(p, bounds, p.tmax, SPLIT_SLACK);
-            if open.none() {
-                stats.packets_culled += 1;
-                continue;
+            if cull {
+                if batch.may_enter(tile, chunk, bounds) >> lane & 1 == 0 {
+                    stats.packets_culled += 1;
+                    continue;
+                }
+                open = open & overlaps_box(p, bounds, p.tmax, SPLIT_SLACK);
+                if open.none() {
+                    stats.packets_culled += 1;
+                    continue;
+                }
             }
-        }
-        stats.packets_tested += 1;
-        for &id in ids {
-            stats.isect_tests += 1;
-            blocked[j] = blocked[j] | occlude_packet(p, tree.triangles().get(id), open);
-            open = open & !blocked[j];
-            if open.none() {
-                break;
+            stats.packets_tested += 1;
+            for &id in ids {
+                stats.isect_tests += 1;
+                blocked[j] = blocked[j] | occlude_packet(p, tree.triangles().get(id), open);
+                open = open & !blocked[j];
+                if open.none() {
+                    break;
+                }
             }
+            finished += (p.valid & !blocked[j]).none() as usize;
         }
-        finished += (p.valid & !blocked[j]).none() as usize;
     }
     finished
 }
@@ -183,6 +237,7 @@ pub(super) trait FrustumLeaf {
 struct ClosestLeaves<'a, V: Vf32> {
     tile: &'a mut PacketTile<V>,
     set: &'a [usize],
+    chunks: ChunkSet,
     cull: bool,
     limit: f32,
 }
@@ -190,7 +245,7 @@ struct ClosestLeaves<'a, V: Vf32> {
 impl<V: Vf32> FrustumLeaf for ClosestLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
-        if leaf_intersect(leaf, self.tile, self.set, self.cull, &mut BatchBits::<1>::default(), stats) {
+        if leaf_intersect(leaf, self.tile, &self.chunks, self.cull, &mut BatchBits::<1>::default(), stats) {
             self.limit = hit_limit(self.tile, self.set);
         }
         (self.limit, false)
@@ -200,7 +255,7 @@ impl<V: Vf32> FrustumLeaf for ClosestLeaves<'_, V> {
 /// Occlusion of packets `set`: the walk stops once every lane is blocked.
 struct BlockedLeaves<'a, V: Vf32> {
     tile: &'a PacketTile<V>,
-    set: &'a [usize],
+    set: ChunkSet,
     cull: bool,
     blocked: &'a mut [V::Mask],
     /// Packets of `set` with a lane not blocked yet.
@@ -211,7 +266,7 @@ impl<V: Vf32> FrustumLeaf for BlockedLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
         let batch = &mut BatchBits::<1>::default();
-        self.open -= leaf_occlude(leaf, self.tile, self.set, self.cull, batch, self.blocked, stats);
+        self.open -= leaf_occlude(leaf, self.tile, &self.set, self.cull, batch, self.blocked, stats);
         (f32::INFINITY, self.open == 0)
     }
 }
@@ -246,7 +301,8 @@ impl KdTree {
         cull: bool,
         stats: &mut TraversalStats,
     ) {
-        self.traverse_frustum(f, stats, &mut ClosestLeaves { tile, set, cull, limit: f32::INFINITY });
+        let chunks = ChunkSet::new::<V>(set);
+        self.traverse_frustum(f, stats, &mut ClosestLeaves { tile, set, chunks, cull, limit: f32::INFINITY });
     }
 
     /// Marks in `blocked` the lanes of packets `set` that something blocks. The frustum `f` must bound the
@@ -262,6 +318,7 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let open = open_packets(tile, set, blocked);
+        let set = ChunkSet::new::<V>(set);
         self.traverse_frustum(f, stats, &mut BlockedLeaves { tile, set, cull, blocked, open });
     }
 
@@ -314,5 +371,21 @@ impl KdTree {
         }
         stats.nodes += visited;
         stats.leaves += leaves;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use raylab_simd::scalar::F32x4;
+
+    use super::*;
+
+    /// Packets fall into chunks of four (the scalar lane type's width) whatever order the set names them in,
+    /// each packet once, chunks in the order of their first packet.
+    #[test]
+    fn chunk_sets_hold_every_packet_once() {
+        let set = ChunkSet::new::<F32x4>(&[5, 0, 1, 9, 4, 15, 12]);
+        assert_eq!(set.chunks, vec![(1, 0b0011), (0, 0b0011), (2, 0b0010), (3, 0b1001)]);
+        assert!(ChunkSet::new::<F32x4>(&[]).chunks.is_empty());
     }
 }

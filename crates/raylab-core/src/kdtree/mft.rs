@@ -10,7 +10,7 @@
 
 use raylab_simd::{VMask, Vf32};
 
-use super::frustum::{BatchBits, Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude, open_packets};
+use super::frustum::{BatchBits, ChunkSet, Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude, open_packets};
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::coord;
@@ -87,6 +87,7 @@ trait MftLeaf<V: Vf32> {
 struct ClosestLeaves<'a, V: Vf32> {
     tile: &'a mut PacketTile<V>,
     sets: &'a [Vec<usize>; 4],
+    chunks: [ChunkSet; 4],
     cull: bool,
     limit: [f32; 4],
 }
@@ -96,9 +97,9 @@ impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32) {
         // One set of batched verdicts for the four frustums: their packets share chunks.
         let batch = &mut BatchBits::<4>::default();
-        for (i, set) in self.sets.iter().enumerate() {
+        for (i, (set, chunks)) in self.sets.iter().zip(&self.chunks).enumerate() {
             let leaf = Leaf { near: near[i], ..*leaf };
-            if active >> i & 1 == 1 && leaf_intersect(&leaf, self.tile, set, self.cull, batch, stats) {
+            if active >> i & 1 == 1 && leaf_intersect(&leaf, self.tile, chunks, self.cull, batch, stats) {
                 self.limit[i] = hit_limit(self.tile, set);
             }
         }
@@ -109,7 +110,7 @@ impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
 /// Occlusion: a frustum is finished once all its packets' lanes are blocked.
 struct BlockedLeaves<'a, V: Vf32> {
     tile: &'a PacketTile<V>,
-    sets: &'a [Vec<usize>; 4],
+    sets: [ChunkSet; 4],
     cull: bool,
     blocked: &'a mut [V::Mask],
     /// Per frustum, the packets with a lane not blocked yet.
@@ -134,6 +135,18 @@ impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
     }
 }
 
+/// The four frustums' packet sets as [`ChunkSet`]s (written out rather than with `array::map`, which may stay
+/// out of line; see `map3`).
+#[inline(always)]
+fn chunk_sets<V: Vf32>(sets: &[Vec<usize>; 4]) -> [ChunkSet; 4] {
+    [
+        ChunkSet::new::<V>(&sets[0]),
+        ChunkSet::new::<V>(&sets[1]),
+        ChunkSet::new::<V>(&sets[2]),
+        ChunkSet::new::<V>(&sets[3]),
+    ]
+}
+
 /// A pending child: its node, the four frustums' intervals there and the frustums that reach it.
 #[derive(Clone, Copy)]
 struct Entry<Q: Vf32> {
@@ -156,7 +169,8 @@ impl KdTree {
         cull: bool,
         stats: &mut TraversalStats,
     ) {
-        self.traverse_mft(f, stats, &mut ClosestLeaves { tile, sets, cull, limit: [f32::INFINITY; 4] });
+        let chunks = chunk_sets::<V>(sets);
+        self.traverse_mft(f, stats, &mut ClosestLeaves { tile, sets, chunks, cull, limit: [f32::INFINITY; 4] });
     }
 
     /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` lists the packets
@@ -178,6 +192,7 @@ impl KdTree {
             open_packets(tile, &sets[2], blocked),
             open_packets(tile, &sets[3], blocked),
         ];
+        let sets = chunk_sets::<V>(sets);
         self.traverse_mft(f, stats, &mut BlockedLeaves { tile, sets, cull, blocked, open, done: 0 });
     }
 
