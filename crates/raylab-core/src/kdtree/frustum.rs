@@ -149,25 +149,23 @@ fn packet_intersect<V: Vf32>(
     cull: bool,
     stats: &mut TraversalStats,
 ) -> bool {
-    {
-        let p = &tile.packets[j];
-        let hits = &mut tile.hits[j];
-        let active = if cull { overlaps_box(p, bounds, hit_reach_lanes(hits.t), SPLIT_SLACK) } else { p.valid };
-        if active.none() {
-            stats.packets_culled += 1;
-            return false;
-        }
-        stats.packets_tested += 1;
-        let mut packet_changed = false;
-        for &id in ids {
-            stats.isect_tests += 1;
-            packet_changed |= intersect_packet(p, hits, tree.triangles().get(id), id, active).any();
-        }
-        if packet_changed {
-            tile.farthest_hit[j] = hit_reach(V::select(p.valid, hits.t, V::splat(f32::NEG_INFINITY)).reduce_max());
-        }
-        packet_changed
+    let p = &tile.packets[j];
+    let hits = &mut tile.hits[j];
+    let active = if cull { overlaps_box(p, bounds, hit_reach_lanes(hits.t), SPLIT_SLACK) } else { p.valid };
+    if active.none() {
+        stats.packets_culled += 1;
+        return false;
     }
+    stats.packets_tested += 1;
+    let mut packet_changed = false;
+    for &id in ids {
+        stats.isect_tests += 1;
+        packet_changed |= intersect_packet(p, hits, tree.triangles().get(id), id, active).any();
+    }
+    if packet_changed {
+        tile.farthest_hit[j] = hit_reach(V::select(p.valid, hits.t, V::splat(f32::NEG_INFINITY)).reduce_max());
+    }
+    packet_changed
 }
 
 /// Any-hit counterpart of [`leaf_intersect`]: marks lanes blocked by the leaf's triangles in `blocked`.
