@@ -13,7 +13,7 @@ source "$root/scripts/lib/splice.sh"
 # shellcheck source=lib/cpu.sh
 source "$root/scripts/lib/cpu.sh"
 frames=${FRAMES:-60}
-cargo build --release -p raylab-viewer --manifest-path "$root/Cargo.toml"
+cargo build --release -p raylab-viewer -p raylab-bench --manifest-path "$root/Cargo.toml"
 cd "$root"
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(mktemp -d)}
 run=()
@@ -26,10 +26,10 @@ commit=$(git describe --always --dirty --abbrev=12)
 cpu=$(cpu_name)
 {
   echo "Machine and build: commit $commit, $(rustc --version), CPU $cpu ($(nproc) logical CPUs)."
-  echo "Command: \`scripts/viewer-fps.sh\` (FRAMES=$frames): for each row, \`${run[*]} target/release/raylab ${sponza[*]} --width W --height H --method M --tile T --shadows hard --frames $frames --json-stats FILE\`; the panel is shown."
+  echo "Command: \`scripts/viewer-fps.sh\` (FRAMES=$frames): for each row, \`${run[*]} target/release/raylab ${sponza[*]} --width W --height H --method M --tile T --shadows hard --frames $frames --json-stats FILE\`; the panel is shown. Headless FPS: the same frame without a window, \`target/release/raylab-bench render ${sponza[*]} --width W --height H --method M --tile T --shadows hard --frames $frames\` (median frame), run right after the viewer."
   echo
-  echo "| view | window | method | tile | FPS (median frame) | frame ms (median) | Mrays/s | N | I | upload CPU ms, mean (wall) | UI CPU ms, mean (wall) | upload + UI CPU ms, median (mean) | UI frames/s | UI frames / egui draws |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| view | window | method | tile | FPS (median frame) | frame ms (median) | Mrays/s | N | I | upload CPU ms, mean (wall) | UI CPU ms, mean (wall) | upload + UI CPU ms, median (mean) | UI frames/s | UI frames / egui draws | headless FPS (median frame) |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$table"
 for size in 1280x720 512x512; do
   for cfg in mft:8 mft:16 mft:32 frustum:16 packet:16 mono:16; do
@@ -38,7 +38,10 @@ for size in 1280x720 512x512; do
     stats="$work/$method-$tile-$size.json"
     "${run[@]}" target/release/raylab "${sponza[@]}" --width "$w" --height "$h" --method "$method" --tile "$tile" \
       --shadows hard --frames "$frames" --json-stats "$stats" >/dev/null
-    python3 - "$stats" "$size" "$method" "$tile" "$frames" >> "$table" <<'PY'
+    headless=$(target/release/raylab-bench render "${sponza[@]}" --width "$w" --height "$h" --method "$method" \
+      --tile "$tile" --shadows hard --frames "$frames" --out "$work/headless.png" \
+      | sed -n 's/^[0-9]* frames: median [0-9.]* ms (\([0-9.]*\) FPS).*/\1/p')
+    python3 - "$stats" "$size" "$method" "$tile" "$frames" "$headless" >> "$table" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
 r = s["readouts"]
@@ -48,7 +51,7 @@ print(f"| Sponza | {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {r['fps_media
       f"| {r['mrays_per_s']:.2f} | {r['n']:.2f} | {r['i']:.2f} "
       f"| {r['upload_ms_mean']:.2f} ({r['upload_wall_ms_mean']:.2f}) | {r['ui_ms_mean']:.2f} ({r['ui_wall_ms_mean']:.2f}) "
       f"| {r['upload_and_ui_ms_median']:.2f} ({r['upload_ms_mean'] + r['ui_ms_mean']:.2f}) "
-      f"| {r['ui_frames'] / ui_s:.0f} | {r['ui_frames']} / {draws} |")
+      f"| {r['ui_frames'] / ui_s:.0f} | {r['ui_frames']} / {draws} | {sys.argv[6]} |")
 PY
   done
 done

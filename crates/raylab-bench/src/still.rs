@@ -26,18 +26,23 @@ pub struct Still {
     pub frame: Frame,
     /// Seconds spent loading the scene.
     pub load_s: f64,
-    /// Seconds spent rendering.
+    /// Seconds spent rendering: the median over the frames rendered.
     pub render_s: f64,
+    /// Seconds each rendered frame took, in order (the first includes setting up MBVH or DACRT).
+    pub frame_s: Vec<f64>,
 }
 
-/// Renders `scene`'s view with `options` on `threads` threads; `settings` makes the frame settings for the
-/// scene's light (the default edge-width radius is the light's radius).
+/// Renders `scene`'s view with `options` on `threads` threads, `frames` times over (at least once: the later
+/// frames find warm caches and buffers, as a viewer's do); `settings` makes the frame settings for the scene's
+/// light (the default edge-width radius is the light's radius). Every frame is the same image; the one kept
+/// carries the stage times of the median frame.
 pub fn render_still(
     scene: &SceneArgs,
     kd: &KdParams,
     options: TraceOptions,
     settings: impl FnOnce(&PointLight) -> RenderSettings,
     threads: usize,
+    frames: usize,
 ) -> Result<Still, String> {
     let (loaded, load_s) = load_scene(&scene.source())?;
     let (camera, light) = scene.camera_and_light(&loaded)?;
@@ -57,18 +62,26 @@ pub fn render_still(
         d.backend = options.backend;
         d
     });
-    let frame = {
-        let mut tracer = Tracer::new(&tree, reference.as_ref(), options);
-        if let Some(m) = &mbvh {
-            tracer = tracer.with_mbvh(m);
-        }
-        if let Some(d) = &dacrt {
-            tracer = tracer.with_dacrt(d);
-        }
-        pool.install(|| render(&loaded, &tracer, &camera, light, settings))
-    };
-    let render_s = t0.elapsed().as_secs_f64();
-    Ok(Still { scene: loaded, tree, frame, load_s, render_s })
+    let mut tracer = Tracer::new(&tree, reference.as_ref(), options);
+    if let Some(m) = &mbvh {
+        tracer = tracer.with_mbvh(m);
+    }
+    if let Some(d) = &dacrt {
+        tracer = tracer.with_dacrt(d);
+    }
+    let mut timed = Vec::with_capacity(frames.max(1));
+    let mut frame = pool.install(|| render(&loaded, &tracer, &camera, light, settings));
+    timed.push((t0.elapsed().as_secs_f64(), frame.stages));
+    for _ in 1..frames {
+        let t = Instant::now();
+        frame = pool.install(|| render(&loaded, &tracer, &camera, light, settings));
+        timed.push((t.elapsed().as_secs_f64(), frame.stages));
+    }
+    let frame_s: Vec<f64> = timed.iter().map(|&(s, _)| s).collect();
+    timed.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (render_s, stages) = timed[timed.len() / 2];
+    frame.stages = stages;
+    Ok(Still { scene: loaded, tree, frame, load_s, render_s, frame_s })
 }
 
 impl Still {

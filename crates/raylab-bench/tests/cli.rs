@@ -26,6 +26,32 @@ fn render_writes_a_png() {
 }
 
 #[test]
+fn repeated_frames_report_their_times_and_keep_the_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |frames: &str, name: &str| {
+        let out = dir.path().join(name);
+        let args = ["render", "--scene", "atrium", "--width", "40", "--height", "30", "--threads", "2", "--frames"];
+        let o = bench(&[&args[..], &[frames, "--out", out.to_str().unwrap()]].concat(), dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        (String::from_utf8_lossy(&o.stdout).into_owned(), image::open(&out).expect("a PNG").to_rgba8())
+    };
+    let (once, first) = render("1", "one.png");
+    let (many, last) = render("5", "five.png");
+    assert!(!once.contains("frames: median"), "{once}");
+    let line = many.lines().find(|l| l.starts_with("5 frames: median")).unwrap_or_else(|| panic!("{many}"));
+    let ms: Vec<f64> = line
+        .split_whitespace()
+        .zip(line.split_whitespace().skip(1))
+        .filter(|(_, unit)| unit.trim_matches(|c| c == ',' || c == ')') == "ms")
+        .map(|(v, _)| v.trim_start_matches('(').parse().unwrap())
+        .collect();
+    let [median, min, max] = ms[..] else { panic!("median, min and max in ms: {line}") };
+    assert!(min > 0.0 && min <= median && median <= max, "{line}");
+    assert!(many.contains("stages (median frame, summed over threads)"), "{many}");
+    assert_eq!(first, last, "every frame is the same image");
+}
+
+#[test]
 fn trace_json_is_one_object_with_checksums() {
     let dir = tempfile::tempdir().unwrap();
     for kind in ["primary", "shadow", "diffuse"] {
@@ -86,6 +112,7 @@ fn bad_input_is_refused_with_a_clear_error() {
         (&["render", "--scene", "arena", "--edge-radius", "-1"], ">= 0"),
         (&["render", "--scene", "arena", "--light-radius", "nan"], ">= 0"),
         (&["render", "--scene", "arena", "--depth", "99"], "0..=16"),
+        (&["render", "--scene", "arena", "--frames", "0"], "1..=100000"),
         (&["render", "--scene", "arena", "--ms-bound", "box"], "packets, fitted, pyramid or cone"),
         (&["trace", "--scene", "arena", "--kind", "glossy"], "primary, shadow, diffuse"),
         (&["trace", "--scene", "arena", "--method", "warp"], "mono"),

@@ -91,7 +91,7 @@ fn reference(method: Method, shadows: ShadowKind, show: FrameView) -> image::Rgb
     };
     let options = TraceOptions { method, ..TraceOptions::default() };
     let kd = KdParams::for_method(method);
-    render_still(&SceneArgs::named("atrium"), &kd, options, settings, 2).unwrap().image().unwrap()
+    render_still(&SceneArgs::named("atrium"), &kd, options, settings, 2, 1).unwrap().image().unwrap()
 }
 
 fn rect(v: &serde_json::Value) -> [f32; 4] {

@@ -37,6 +37,10 @@ pub struct RenderArgs {
     /// Worker threads (default: all CPUs).
     #[arg(long, value_parser = in_range(1, 1024))]
     threads: Option<u64>,
+    /// Render the frame this many times and report the median frame time and its stages: the tracing and
+    /// shading cost of a viewer frame, without the window.
+    #[arg(long, default_value_t = 1, value_parser = in_range(1, 100_000))]
+    frames: u64,
 }
 
 impl RenderArgs {
@@ -66,8 +70,9 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         view: a.show,
         heat_max: a.heat_max,
     };
-    let Still { scene, tree, frame, load_s, render_s } =
-        render_still(&a.scene, &a.kd.params_for(a.m.method)?, a.m.options(), settings, threads)?;
+    let frames = a.frames as usize;
+    let Still { scene, tree, frame, load_s, render_s, frame_s } =
+        render_still(&a.scene, &a.kd.params_for(a.m.method)?, a.m.options(), settings, threads, frames)?;
     let img = image::RgbaImage::from_raw(frame.width, frame.height, frame.rgba.as_flattened().to_vec())
         .ok_or("frame buffer size mismatch")?;
     img.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
@@ -92,7 +97,18 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         .filter(|&(_, t)| t > 0.0)
         .map(|(name, t)| format!("{name} {:.1} ms", t * 1e3))
         .collect();
-    println!("stages (summed over threads): {}", stages.join(", "));
+    if frames > 1 {
+        let (min, max) = frame_s.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+        println!(
+            "{frames} frames: median {:.2} ms ({:.1} FPS), min {:.2} ms, max {:.2} ms",
+            render_s * 1e3,
+            1.0 / render_s,
+            min * 1e3,
+            max * 1e3
+        );
+    }
+    let which = if frames > 1 { "median frame, summed over threads" } else { "summed over threads" };
+    println!("stages ({which}): {}", stages.join(", "));
     let shown = std::fs::canonicalize(&a.out).unwrap_or_else(|_| a.out.clone());
     println!("wrote {}", shown.display());
     Ok(())
