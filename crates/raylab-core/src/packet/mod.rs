@@ -197,6 +197,28 @@ pub struct PacketHits<V: Vf32> {
     pub hit: V::Mask,
 }
 
+/// A packet's hits spilled from vectors to per-lane arrays ([`PacketHits::lanes`]).
+pub struct HitLanes<V: Vf32> {
+    t: V::Array<f32>,
+    u: V::Array<f32>,
+    v: V::Array<f32>,
+    tri: V::Array<u32>,
+    bits: u32,
+}
+
+impl<V: Vf32> HitLanes<V> {
+    /// The hit of lane `i`, if it has one.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Option<Hit> {
+        (self.bits >> i & 1 == 1).then(|| Hit {
+            t: self.t.as_ref()[i],
+            tri: self.tri.as_ref()[i],
+            u: self.u.as_ref()[i],
+            v: self.v.as_ref()[i],
+        })
+    }
+}
+
 impl<V: Vf32> PacketHits<V> {
     /// No hits yet: `t` starts at each ray's `tmax`.
     #[inline(always)]
@@ -213,19 +235,19 @@ impl<V: Vf32> PacketHits<V> {
     /// The hits of all lanes at once (cheaper than [`PacketHits::get`] per lane).
     #[inline(always)]
     pub fn to_hits(&self) -> V::Array<Option<Hit>> {
+        let lanes = self.lanes();
+        V::array_from_fn(|i| lanes.get(i))
+    }
+
+    /// The lanes spilled to arrays once, to be read one by one ([`HitLanes::get`]): writing a tile's hits
+    /// straight to their pixels this way skips the array of [`PacketHits::to_hits`].
+    #[inline(always)]
+    pub fn lanes(&self) -> HitLanes<V> {
         let (mut t, mut u, mut v) = (V::array_from_fn(|_| 0.0), V::array_from_fn(|_| 0.0), V::array_from_fn(|_| 0.0));
         self.t.write_to(t.as_mut());
         self.u.write_to(u.as_mut());
         self.v.write_to(v.as_mut());
-        let (t, u, v, tri) = (t.as_ref(), u.as_ref(), v.as_ref(), self.tri.as_ref());
-        let bits = self.hit.bits();
-        let mut out = V::array_from_fn(|_| None);
-        for (i, h) in out.as_mut().iter_mut().enumerate() {
-            if bits >> i & 1 == 1 {
-                *h = Some(Hit { t: t[i], tri: tri[i], u: u[i], v: v[i] });
-            }
-        }
-        out
+        HitLanes { t, u, v, tri: self.tri, bits: self.hit.bits() }
     }
 
     /// The hit of lane `i`.

@@ -424,8 +424,8 @@ impl<'a> Tracer<'a> {
             self.packets_intersect(&mut tile, stats);
         }
         for (j, hits) in tile.hits.iter().enumerate() {
-            let lanes = hits.to_hits();
-            tile.for_each_lane(j, |pixel, lane| out[pixel] = lanes.as_ref()[lane]);
+            let lanes = hits.lanes();
+            tile.for_each_lane(j, |pixel, lane| out[pixel] = lanes.get(lane));
         }
     }
 
