@@ -87,7 +87,7 @@ pub(super) struct ChunkSet {
 impl ChunkSet {
     /// The chunks of packets `set` for lane type `V`.
     pub fn new<V: Vf32>(set: &[usize]) -> Self {
-        let mut chunks: Vec<(usize, u32)> = Vec::new();
+        let mut chunks: Vec<(usize, u32)> = Vec::with_capacity(set.len());
         for &j in set {
             let (chunk, bit) = (j / V::LANES, 1u32 << (j % V::LANES));
             match chunks.iter_mut().rev().find(|(c, _)| *c == chunk) {

@@ -191,8 +191,9 @@ pub struct PacketHits<V: Vf32> {
     pub u: V,
     /// Barycentric weight of vertex 2.
     pub v: V,
-    /// Triangle id per lane (`u32::MAX` where nothing was hit).
-    pub tri: V::Array<u32>,
+    /// Triangle id per lane as the bits of an `f32` (`u32::MAX` where nothing was hit): kept in a vector so a
+    /// hit updates it with one select, like the distances, instead of a store per lane.
+    pub tri: V,
     /// Lanes that hit something.
     pub hit: V::Mask,
 }
@@ -202,7 +203,7 @@ pub struct HitLanes<V: Vf32> {
     t: V::Array<f32>,
     u: V::Array<f32>,
     v: V::Array<f32>,
-    tri: V::Array<u32>,
+    tri: V::Array<f32>,
     bits: u32,
 }
 
@@ -212,7 +213,7 @@ impl<V: Vf32> HitLanes<V> {
     pub fn get(&self, i: usize) -> Option<Hit> {
         (self.bits >> i & 1 == 1).then(|| Hit {
             t: self.t.as_ref()[i],
-            tri: self.tri.as_ref()[i],
+            tri: self.tri.as_ref()[i].to_bits(),
             u: self.u.as_ref()[i],
             v: self.v.as_ref()[i],
         })
@@ -227,7 +228,7 @@ impl<V: Vf32> PacketHits<V> {
             t: p.tmax,
             u: V::splat(0.0),
             v: V::splat(0.0),
-            tri: V::array_from_fn(|_| u32::MAX),
+            tri: V::splat(f32::from_bits(u32::MAX)),
             hit: V::Mask::from_bits(0),
         }
     }
@@ -243,11 +244,12 @@ impl<V: Vf32> PacketHits<V> {
     /// straight to their pixels this way skips the array of [`PacketHits::to_hits`].
     #[inline(always)]
     pub fn lanes(&self) -> HitLanes<V> {
-        let (mut t, mut u, mut v) = (V::array_from_fn(|_| 0.0), V::array_from_fn(|_| 0.0), V::array_from_fn(|_| 0.0));
-        self.t.write_to(t.as_mut());
-        self.u.write_to(u.as_mut());
-        self.v.write_to(v.as_mut());
-        HitLanes { t, u, v, tri: self.tri, bits: self.hit.bits() }
+        let spill = |x: V| {
+            let mut a = V::array_from_fn(|_| 0.0);
+            x.write_to(a.as_mut());
+            a
+        };
+        HitLanes { t: spill(self.t), u: spill(self.u), v: spill(self.v), tri: spill(self.tri), bits: self.hit.bits() }
     }
 
     /// The hit of lane `i`.
@@ -255,7 +257,7 @@ impl<V: Vf32> PacketHits<V> {
     pub fn get(&self, i: usize) -> Option<Hit> {
         (self.hit.bits() >> i & 1 == 1).then(|| Hit {
             t: self.t.lane(i),
-            tri: self.tri.as_ref()[i],
+            tri: self.tri.lane(i).to_bits(),
             u: self.u.lane(i),
             v: self.v.lane(i),
         })

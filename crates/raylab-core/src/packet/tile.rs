@@ -131,9 +131,10 @@ impl<V: Vf32> PacketTile<V> {
     #[inline(always)]
     pub fn packets_in(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> Vec<usize> {
         let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
-        let mut v = Vec::new();
-        for by in y0 / ph..y1.div_ceil(ph).min(self.rows) {
-            for bx in x0 / pw..x1.div_ceil(pw).min(self.cols) {
+        let (ys, xs) = (y0 / ph..y1.div_ceil(ph).min(self.rows), x0 / pw..x1.div_ceil(pw).min(self.cols));
+        let mut v = Vec::with_capacity(ys.len() * xs.len());
+        for by in ys {
+            for bx in xs.clone() {
                 v.push(by * self.cols + bx);
             }
         }

@@ -146,7 +146,7 @@ pub fn intersect_packet<V: Vf32>(
             while bits != 0 {
                 let lane = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
-                if hits.tri.as_ref()[lane] < id {
+                if hits.tri.lane(lane).to_bits() < id {
                     keep &= !(1 << lane);
                 }
             }
@@ -155,13 +155,8 @@ pub fn intersect_packet<V: Vf32>(
         hits.t = V::select(mask, r.t, hits.t);
         hits.u = V::select(mask, r.u, hits.u);
         hits.v = V::select(mask, r.v, hits.v);
+        hits.tri = V::select(mask, V::splat(f32::from_bits(id)), hits.tri);
         hits.hit = hits.hit | mask;
-        let bits = mask.bits();
-        for (i, slot) in hits.tri.as_mut().iter_mut().enumerate() {
-            if bits >> i & 1 == 1 {
-                *slot = id;
-            }
-        }
     }
     mask
 }
