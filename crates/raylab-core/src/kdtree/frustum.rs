@@ -231,10 +231,9 @@ pub(super) trait FrustumLeaf {
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool);
 }
 
-/// Closest hits of packets `set`; `limit` is their farthest current hit.
+/// Closest hits of the packets in `chunks`; `limit` is their farthest current hit.
 struct ClosestLeaves<'a, V: Vf32> {
     tile: &'a mut PacketTile<V>,
-    set: &'a [usize],
     chunks: ChunkSet,
     cull: bool,
     limit: f32,
@@ -244,7 +243,7 @@ impl<V: Vf32> FrustumLeaf for ClosestLeaves<'_, V> {
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
         if leaf_intersect(leaf, self.tile, &self.chunks, self.cull, &mut BatchBits::<1>::default(), stats) {
-            self.limit = hit_limit(self.tile, self.set);
+            self.limit = hit_limit(self.tile, &self.chunks);
         }
         (self.limit, false)
     }
@@ -281,10 +280,17 @@ pub(super) fn open_packets<V: Vf32>(tile: &PacketTile<V>, set: &[usize], blocked
     open
 }
 
-/// The largest current hit distance over the lanes of packets `set` (infinite while any lane has none).
+/// The largest current hit distance over the lanes of the packets in `set` (infinite while any lane has
+/// none), and at least 0: a chunk's farthest hits at a time, since a leaf that moved a hit asks it again.
 #[inline(always)]
-pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> f32 {
-    set.iter().fold(0.0f32, |m, &j| m.max(tile.farthest_hit[j]))
+pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &ChunkSet) -> f32 {
+    let mut limit = V::splat(0.0);
+    for &(chunk, members) in &set.chunks {
+        let first = chunk * V::LANES;
+        let farthest = V::from_slice(&tile.farthest_hit[first..first + V::LANES]);
+        limit = limit.max(V::select(V::Mask::from_bits(members), farthest, V::splat(f32::NEG_INFINITY)));
+    }
+    limit.reduce_max()
 }
 
 impl KdTree {
@@ -300,7 +306,7 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let chunks = ChunkSet::new::<V>(set);
-        self.traverse_frustum(f, stats, &mut ClosestLeaves { tile, set, chunks, cull, limit: f32::INFINITY });
+        self.traverse_frustum(f, stats, &mut ClosestLeaves { tile, chunks, cull, limit: f32::INFINITY });
     }
 
     /// Marks in `blocked` the lanes of packets `set` that something blocks. The frustum `f` must bound the

@@ -86,7 +86,6 @@ trait MftLeaf<V: Vf32> {
 /// Closest hits: `limit[i]` is the farthest current hit of frustum `i`'s packets.
 struct ClosestLeaves<'a, V: Vf32> {
     tile: &'a mut PacketTile<V>,
-    sets: &'a [Vec<usize>; 4],
     chunks: [ChunkSet; 4],
     cull: bool,
     limit: [f32; 4],
@@ -97,10 +96,10 @@ impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32) {
         // One set of batched verdicts for the four frustums: their packets share chunks.
         let batch = &mut BatchBits::<4>::default();
-        for (i, (set, chunks)) in self.sets.iter().zip(&self.chunks).enumerate() {
+        for (i, chunks) in self.chunks.iter().enumerate() {
             let leaf = Leaf { near: near[i], ..*leaf };
             if active >> i & 1 == 1 && leaf_intersect(&leaf, self.tile, chunks, self.cull, batch, stats) {
-                self.limit[i] = hit_limit(self.tile, set);
+                self.limit[i] = hit_limit(self.tile, chunks);
             }
         }
         (Q::<V>::from_slice(&self.limit), 0)
@@ -170,7 +169,7 @@ impl KdTree {
         stats: &mut TraversalStats,
     ) {
         let chunks = chunk_sets::<V>(sets);
-        self.traverse_mft(f, stats, &mut ClosestLeaves { tile, sets, chunks, cull, limit: [f32::INFINITY; 4] });
+        self.traverse_mft(f, stats, &mut ClosestLeaves { tile, chunks, cull, limit: [f32::INFINITY; 4] });
     }
 
     /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` lists the packets

@@ -19,8 +19,9 @@ fn pick<V: Vf32>(is: [V::Mask; 2], x: V, y: V, z: V) -> V {
 
 /// Corner `v` relative to the packet's origins, components in `(kx, ky, kz)` order for every lane.
 #[inline(always)]
-fn rel_uniform<V: Vf32>(p: &RayPacket<V>, v: Vec3, [kx, ky, kz]: [usize; 3]) -> (V, V, V) {
-    let v = v.to_array();
+fn rel_uniform<V: Vf32>(p: &RayPacket<V>, v: &Vec3, [kx, ky, kz]: [usize; 3]) -> (V, V, V) {
+    // Indexing the corner where it lies loads each component straight from the triangle, with no copy first.
+    let v: &[f32; 3] = v.as_ref();
     (V::splat(v[kx]) - p.org[kx], V::splat(v[ky]) - p.org[ky], V::splat(v[kz]) - p.org[kz])
 }
 
@@ -92,7 +93,7 @@ fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) ->
     // Corners relative to the origins, permuted into (kx, ky, kz) order: by indexing when every lane shares
     // the permutation, by per-lane selects otherwise. Both give each lane exactly `v[k] - o[k]`.
     let corners = match p.uniform_axes {
-        Some(k) => [rel_uniform(p, tri[0], k), rel_uniform(p, tri[1], k), rel_uniform(p, tri[2], k)],
+        Some(k) => [rel_uniform(p, &tri[0], k), rel_uniform(p, &tri[1], k), rel_uniform(p, &tri[2], k)],
         None => [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])],
     };
     let lanes = sheared_test(corners, p.shear, p.tmin, tmax);
