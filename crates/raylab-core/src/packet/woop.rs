@@ -38,7 +38,15 @@ fn rel_permuted<V: Vf32>(p: &RayPacket<V>, v: Vec3) -> (V, V, V) {
 /// packet test (four rays, one triangle) and [`crate::tri4`] (one ray, four triangles), each lane performing
 /// [`crate::triangle::RayShear::intersect`]'s `f32` operations in its order.
 #[inline(always)]
-pub(crate) fn sheared_test<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3], tmin: V, tmax: V) -> Sheared<V> {
+pub(crate) fn sheared_test<V: Vf32>(corners: [(V, V, V); 3], shear: [V; 3], tmin: V, tmax: V) -> Sheared<V> {
+    sheared_edges(corners, shear, tmin, tmax).finish(tmin, tmax)
+}
+
+/// The first part of [`sheared_test`]: the edge functions and the scaled distance, which decide every lane
+/// but the few that the division's rounding moves out of `(tmin, tmax]`. A packet test whose lanes all miss
+/// here skips the division and what follows it.
+#[inline(always)]
+fn sheared_edges<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3], tmin: V, tmax: V) -> Edges<V> {
     let [(a_x, a_y, a_z), (b_x, b_y, b_z), (c_x, c_y, c_z)] = corners;
     let ax = a_x - sx * a_z;
     let ay = a_y - sy * a_z;
@@ -58,11 +66,30 @@ pub(crate) fn sheared_test<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3
     let abs_det = det.abs();
     let t_signed = V::select(det.lt(zero), zero - t_scaled, t_scaled);
     let inside = t_signed.gt(tmin * abs_det) & t_signed.le(tmax * abs_det * V::splat(SCALED_FAR_SLACK));
-    let inv = V::splat(1.0) / det;
-    let t = t_scaled * inv;
-    let in_range = t.gt(tmin) & t.le(tmax);
-    let hit = !exact_zero & !(neg & pos) & !det.eq(zero) & inside & in_range;
-    Sheared { hit, exact_zero, t, u: v * inv, v: w * inv }
+    let maybe = !exact_zero & !(neg & pos) & !det.eq(zero) & inside;
+    Edges { maybe, exact_zero, det, t_scaled, v, w }
+}
+
+/// What [`sheared_edges`] leaves for the division.
+struct Edges<V: Vf32> {
+    /// Lanes that hit unless the division's rounding puts `t` outside `(tmin, tmax]`.
+    maybe: V::Mask,
+    exact_zero: V::Mask,
+    det: V,
+    t_scaled: V,
+    v: V,
+    w: V,
+}
+
+impl<V: Vf32> Edges<V> {
+    /// The distances and barycentrics, and the lanes that hit.
+    #[inline(always)]
+    fn finish(self, tmin: V, tmax: V) -> Sheared<V> {
+        let inv = V::splat(1.0) / self.det;
+        let t = self.t_scaled * inv;
+        let in_range = t.gt(tmin) & t.le(tmax);
+        Sheared { hit: self.maybe & in_range, exact_zero: self.exact_zero, t, u: self.v * inv, v: self.w * inv }
+    }
 }
 
 /// What [`sheared_test`] finds per lane.
@@ -96,8 +123,14 @@ fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) ->
         Some(k) => [rel_uniform(p, &tri[0], k), rel_uniform(p, &tri[1], k), rel_uniform(p, &tri[2], k)],
         None => [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])],
     };
-    let lanes = sheared_test(corners, p.shear, p.tmin, tmax);
-    let exact_zero = lanes.exact_zero & active;
+    let edges = sheared_edges(corners, p.shear, p.tmin, tmax);
+    let exact_zero = edges.exact_zero & active;
+    if ((edges.maybe | edges.exact_zero) & active).none() {
+        // Every lane misses: no division. The distances are only read where a lane hits.
+        let zero = V::splat(0.0);
+        return LaneHits { mask: V::Mask::from_bits(0), t: zero, u: zero, v: zero };
+    }
+    let lanes = edges.finish(p.tmin, tmax);
     let mut mask = lanes.hit & active;
     let (mut t, mut bu, mut bv) = (lanes.t, lanes.u, lanes.v);
     if exact_zero.any() {
