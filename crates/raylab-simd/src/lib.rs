@@ -44,7 +44,7 @@ pub trait VMask:
 /// `min(a, b)` and `max(a, b)` follow the SSE rule: when either lane is NaN the lane of `b` is returned,
 /// so `a.min(b)` with a NaN `a` keeps `b`. Comparisons with NaN are false.
 pub trait Vf32:
-    Copy + Debug + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+    Copy + Debug + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + 'static
 {
     /// The mask type of comparisons.
     type Mask: VMask;

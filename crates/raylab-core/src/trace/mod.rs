@@ -9,6 +9,8 @@ mod proxy;
 
 pub use proxy::Proxy;
 
+use std::any::Any;
+use std::cell::Cell;
 use std::ops::Range;
 
 use glam::Vec3;
@@ -366,62 +368,68 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// [`Tracer::intersect_tile`] for the methods that trace packets, with lane type `V` and the buffers of
+    /// `scratch`.
     #[inline(always)]
     fn intersect_simd<V: Vf32>(
         &self,
+        scratch: &mut TileScratch<V>,
         rays: &[Option<Ray>],
         width: usize,
         height: usize,
         out: &mut [Option<Hit>],
         stats: &mut TraversalStats,
     ) {
-        let mut tile = PacketTile::<V>::new(rays, width, height);
-        let all: Vec<usize> = (0..tile.packets.len()).collect();
+        let TileScratch { all, stack, tile, .. } = scratch;
+        tile.refill(rays, width, height);
+        all.clear();
+        all.extend(0..tile.packets.len());
+        let all = &all[..];
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         // Tiles no bundle covers are traced as packets (after the match, so the packet kernel is inlined once).
         let cull = self.options.cull;
         if cull
             && self.options.method.is_bundled()
-            && let Some(origin) = common_origin(&tile, &all)
+            && let Some(origin) = common_origin(tile, all)
         {
             tile.share_origin(origin);
         }
         let bundled = match self.options.method {
             Method::Frustum => {
-                let f = common_origin_frustum(&tile, &all);
+                let f = common_origin_frustum(tile, all);
                 if let Some(f) = &f {
-                    self.tree.intersect_frustum(f, &mut tile, &all, cull, stats);
+                    self.tree.intersect_frustum(f, tile, all, cull, stats);
                 }
                 f.is_some()
             }
             Method::Cone => {
-                let c = common_origin_cone(&tile, &all);
+                let c = common_origin_cone(tile, all);
                 if let Some(c) = &c {
-                    self.tree.intersect_frustum(c, &mut tile, &all, cull, stats);
+                    self.tree.intersect_frustum(c, tile, all, cull, stats);
                 }
                 c.is_some()
             }
             Method::Mft => {
-                let quads = self.quadrants(&tile, rays, None, common_origin_frustum, toward_frustum);
+                let quads = self.quadrants(tile, rays, None, common_origin_frustum, toward_frustum);
                 let f4 = quads.and_then(|(b, sets, _)| Some((Frustum4::new(b)?, sets)));
                 if let Some((f4, sets)) = &f4 {
-                    self.tree.intersect_mft(f4, &mut tile, sets, cull, stats);
+                    self.tree.intersect_mft(f4, tile, sets, cull, stats);
                 }
                 f4.is_some()
             }
             Method::MftCone => {
-                let quads = self.quadrants(&tile, rays, None, common_origin_cone, toward_cone);
+                let quads = self.quadrants(tile, rays, None, common_origin_cone, toward_cone);
                 let c4 = quads.and_then(|(b, sets, _)| Some((Frustum4::new(b)?, sets)));
                 if let Some((c4, sets)) = &c4 {
-                    self.tree.intersect_mft(c4, &mut tile, sets, cull, stats);
+                    self.tree.intersect_mft(c4, tile, sets, cull, stats);
                 }
                 c4.is_some()
             }
             _ => false,
         };
         if !bundled {
-            self.packets_intersect(&mut tile, stats);
+            self.packets_intersect(tile, stack, stats);
         }
         for (j, hits) in tile.hits.iter().enumerate() {
             let lanes = hits.lanes();
@@ -430,10 +438,14 @@ impl<'a> Tracer<'a> {
     }
 
     #[inline(always)]
-    fn packets_intersect<V: Vf32>(&self, tile: &mut PacketTile<V>, stats: &mut TraversalStats) {
-        let mut stack = PacketStack::default();
+    fn packets_intersect<V: Vf32>(
+        &self,
+        tile: &mut PacketTile<V>,
+        stack: &mut PacketStack<V>,
+        stats: &mut TraversalStats,
+    ) {
         for (p, h) in tile.packets.iter().zip(tile.hits.iter_mut()) {
-            self.tree.intersect_packet(p, h, &mut stack, stats);
+            self.tree.intersect_packet(p, h, stack, stats);
         }
     }
 
@@ -597,7 +609,9 @@ impl Kernel for IntersectSimd<'_, '_> {
     type Output = ();
     #[inline(always)]
     fn run<V: Vf32>(self) {
-        self.tracer.intersect_simd::<V>(self.rays, self.width, self.height, self.out, self.stats);
+        let mut scratch = TileScratch::<V>::take();
+        self.tracer.intersect_simd::<V>(&mut scratch, self.rays, self.width, self.height, self.out, self.stats);
+        scratch.put_back();
     }
 }
 
@@ -617,7 +631,9 @@ impl Kernel for OccludedSimd<'_, '_> {
     #[inline(always)]
     fn run<V: Vf32>(self) {
         let Self { tracer, rays, width, height, toward, out, stats } = self;
-        tracer.occluded_simd::<V>(&mut TileScratch::default(), rays, width, height, toward, out, stats);
+        let mut scratch = TileScratch::<V>::take();
+        tracer.occluded_simd::<V>(&mut scratch, rays, width, height, toward, out, stats);
+        scratch.put_back();
     }
 }
 
@@ -639,6 +655,25 @@ pub(crate) struct TileScratch<V: Vf32> {
 impl<V: Vf32> Default for TileScratch<V> {
     fn default() -> Self {
         Self { all: Vec::new(), blocked: Vec::new(), stack: PacketStack::default(), tile: PacketTile::empty() }
+    }
+}
+
+thread_local! {
+    /// Each thread's spare [`TileScratch`], for the lane type it last traced a tile with.
+    static SPARE_SCRATCH: Cell<Option<Box<dyn Any>>> = const { Cell::new(None) };
+}
+
+impl<V: Vf32> TileScratch<V> {
+    /// This thread's spare buffers if they are for lane type `V`, else new ones: one-tile calls
+    /// ([`Tracer::intersect_tile`], [`Tracer::occluded_tile`]) would otherwise allocate a tile's packets, hits
+    /// and stack for every tile. A call nested in another finds none spare and allocates its own.
+    pub(crate) fn take() -> Box<Self> {
+        SPARE_SCRATCH.take().and_then(|spare| spare.downcast::<Self>().ok()).unwrap_or_default()
+    }
+
+    /// Leaves these buffers to the thread's next [`TileScratch::take`].
+    pub(crate) fn put_back(self: Box<Self>) {
+        SPARE_SCRATCH.set(Some(self));
     }
 }
 
