@@ -64,13 +64,14 @@ impl KdTree {
 
     /// The edge-width occlusions of `rays`, written to `out`, traced in packets of `V::LANES` rays whose
     /// directions share signs; `states` (at least `V::LANES`, all with the same radius and leak-fix switch)
-    /// are the lanes' reusable states. Equal, ray by ray, to [`KdTree::edge_width`].
+    /// are the lanes' reusable states, `stack` the walk's. Equal, ray by ray, to [`KdTree::edge_width`].
     #[inline(always)]
     pub fn edge_widths<V: Vf32>(
         &self,
         rays: &[Ray],
         states: &mut [EdgeWidth],
         out: &mut [f32],
+        stack: &mut PacketStack<V>,
         stats: &mut TraversalStats,
     ) {
         assert!(rays.len() == out.len() && states.len() >= V::LANES);
@@ -78,7 +79,6 @@ impl KdTree {
         // -infinity), keeping their order (neighbours are coherent) within a group.
         let mut order: Vec<(usize, u32)> = rays.iter().map(|r| r.dir.is_negative_bitmask()).enumerate().collect();
         order.sort_by_key(|&(_, s)| s);
-        let mut stack = PacketStack::default();
         let mut start = 0;
         while start < order.len() {
             let sign = order[start].1;
@@ -95,7 +95,7 @@ impl KdTree {
             stats.rays += group.len() as u64;
             stats.packets += 1;
             let mut walk = EdgeWalks { tree: self, p: &p, states: &mut *states, pending: 0, tests: 0 };
-            self.traverse_packet(&p, Front::Signs(sign as usize), &mut stack, stats, &mut walk);
+            self.traverse_packet(&p, Front::Signs(sign as usize), stack, stats, &mut walk);
             stats.isect_tests += walk.tests;
             for (s, &(i, _)) in states.iter_mut().zip(group) {
                 s.commit(f32::INFINITY, self.triangles());

@@ -217,10 +217,11 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// [`Tracer::edge_widths`] for the packet methods, in vectors of type `V`.
+    /// [`Tracer::edge_widths`] for the packet methods, in vectors of type `V`, with the buffers of `scratch`.
     #[inline(always)]
     fn edge_widths_simd<V: Vf32>(
         &self,
+        scratch: &mut TileScratch<V>,
         rays: &[Ray],
         toward: Option<Vec3>,
         states: &mut [EdgeWidth],
@@ -228,29 +229,31 @@ impl<'a> Tracer<'a> {
         stats: &mut TraversalStats,
     ) {
         let method = self.options.method;
+        let TileScratch { all, stack, tile, rays: grid, .. } = scratch;
         if let Some(toward) = toward.filter(|_| method.is_bundled() && rays.len() >= EDGE_BUNDLE_MIN_RAYS) {
             // The rays in packet order: a tile one packet wide whose packets hold consecutive rays.
             let pw = PacketTile::<V>::PACKET_W;
             let height = rays.len().div_ceil(pw);
-            let mut grid = Vec::with_capacity(pw * height);
+            grid.clear();
             grid.extend(rays.iter().copied().map(Some));
             grid.resize(pw * height, None);
-            let tile = PacketTile::<V>::new(&grid, pw, height);
-            let all: Vec<usize> = (0..tile.packets.len()).collect();
-            let whole =
-                Bundled { tile: &tile, set: &all, rays: RayRect { rays: &grid, width: pw, x: 0..pw, y: 0..height } };
+            tile.refill(grid, pw, height);
+            all.clear();
+            all.extend(0..tile.packets.len());
+            let (tile, grid) = (&*tile, &grid[..]);
+            let whole = Bundled { tile, set: all, rays: RayRect { rays: grid, width: pw, x: 0..pw, y: 0..height } };
             let (limit, cull) = (self.options.shadow_spread_limit, self.options.cull);
             let walked = match method {
                 Method::Cone | Method::MftCone => toward_cone(&whole, toward, limit)
-                    .map(|c| self.tree.edge_widths_bundle(&c, &tile, cull, states, out, stats)),
+                    .map(|c| self.tree.edge_widths_bundle(&c, tile, cull, states, out, stats)),
                 _ => toward_frustum(&whole, toward, limit)
-                    .map(|f| self.tree.edge_widths_bundle(&f, &tile, cull, states, out, stats)),
+                    .map(|f| self.tree.edge_widths_bundle(&f, tile, cull, states, out, stats)),
             };
             if walked.is_some() {
                 return;
             }
         }
-        self.tree.edge_widths::<V>(rays, states, out, stats);
+        self.tree.edge_widths::<V>(rays, states, out, stack, stats);
     }
 
     fn reference(&self) -> &'a BruteForce {
@@ -463,7 +466,7 @@ impl<'a> Tracer<'a> {
         out: &mut [bool],
         stats: &mut TraversalStats,
     ) {
-        let TileScratch { all, blocked, stack, tile } = scratch;
+        let TileScratch { all, blocked, stack, tile, .. } = scratch;
         tile.refill(rays, width, height);
         blocked.clear();
         blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
@@ -650,11 +653,19 @@ pub(crate) struct TileScratch<V: Vf32> {
     pub stack: PacketStack<V>,
     /// The tile of packets, refilled for each bundle ([`PacketTile::refill`]).
     pub tile: PacketTile<V>,
+    /// Rays laid out for `tile` (edge-width walks put theirs one packet wide).
+    pub rays: Vec<Option<Ray>>,
 }
 
 impl<V: Vf32> Default for TileScratch<V> {
     fn default() -> Self {
-        Self { all: Vec::new(), blocked: Vec::new(), stack: PacketStack::default(), tile: PacketTile::empty() }
+        Self {
+            all: Vec::new(),
+            blocked: Vec::new(),
+            stack: PacketStack::default(),
+            tile: PacketTile::empty(),
+            rays: Vec::new(),
+        }
     }
 }
 
@@ -699,7 +710,9 @@ impl Kernel for EdgeWidthsSimd<'_, '_> {
     #[inline(always)]
     fn run<V: Vf32>(self) {
         let Self { tracer, rays, toward, states, out, stats } = self;
-        tracer.edge_widths_simd::<V>(rays, toward, states, out, stats);
+        let mut scratch = TileScratch::<V>::take();
+        tracer.edge_widths_simd::<V>(&mut scratch, rays, toward, states, out, stats);
+        scratch.put_back();
     }
 }
 
