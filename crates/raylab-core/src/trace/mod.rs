@@ -675,9 +675,10 @@ thread_local! {
 }
 
 impl<V: Vf32> TileScratch<V> {
-    /// This thread's spare buffers if they are for lane type `V`, else new ones: one-tile calls
-    /// ([`Tracer::intersect_tile`], [`Tracer::occluded_tile`]) would otherwise allocate a tile's packets, hits
-    /// and stack for every tile. A call nested in another finds none spare and allocates its own.
+    /// This thread's spare buffers if they are for lane type `V`, else new ones: the kernels of one-tile calls
+    /// ([`Tracer::intersect_tile`], [`Tracer::occluded_tile`], [`Tracer::edge_widths`],
+    /// [`Tracer::occluded_in_proxy`]) would otherwise allocate a tile's packets, hits and stack for every call.
+    /// A call nested in another finds none spare and allocates its own.
     pub(crate) fn take() -> Box<Self> {
         SPARE_SCRATCH.take().and_then(|spare| spare.downcast::<Self>().ok()).unwrap_or_default()
     }

@@ -74,7 +74,9 @@ impl Kernel for OccludedInProxy<'_, '_> {
     #[inline(always)]
     fn run<V: Vf32>(self) {
         let Self { tracer, proxy, rays, size, out, stats } = self;
-        tracer.occluded_in_proxy_simd::<V>(&mut TileScratch::default(), proxy, rays, size, out, stats);
+        let mut scratch = TileScratch::<V>::take();
+        tracer.occluded_in_proxy_simd::<V>(&mut scratch, proxy, rays, size, out, stats);
+        scratch.put_back();
     }
 }
 
