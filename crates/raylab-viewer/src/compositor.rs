@@ -2,13 +2,14 @@
 //! full-target triangle (`shaders/frame.wgsl`), then the egui panels over it.
 //!
 //! egui's output is drawn into a texture of its own (the UI layer), which is laid over the frame where egui
-//! drew; its meshes are uploaded and drawn again only when they changed. A redraw of the unchanged UI, the
+//! drew (the cells its triangles touch, [`crate::ui_cover`]); its meshes are uploaded and drawn again only when they changed. A redraw of the unchanged UI, the
 //! common case while frames stream in or the UI is asked to redraw often, then costs one full-target copy and
 //! a blend of the UI's pixels. It matters most on software Vulkan (lavapipe), where egui's fragment shader
 //! costs tens of milliseconds of CPU per draw of a 1280x720 window with the panel, time taken from the tracer
 //! on the same cores.
 
 use crate::gpu::Gpu;
+use crate::ui_cover::{PixelRect, drawn_rects};
 
 /// Format of the frame texture: display-ready 8-bit values.
 pub const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -70,44 +71,6 @@ struct UiLayer {
     pixels_per_point: f32,
     /// The pixels egui drew, as disjoint rectangles (see [`drawn_rects`]).
     rects: Vec<PixelRect>,
-}
-
-/// A rectangle of pixels: `x, y, width, height`, as `set_scissor_rect` takes them.
-type PixelRect = [u32; 4];
-
-/// Disjoint pixel rectangles covering every pixel the meshes of `jobs` may touch in a `size` target (each
-/// mesh's bounds, clipped, rounded outward, overlapping ones merged into their union until none overlap).
-/// Laying the UI layer over these alone is exact, the rest of it being transparent, and blends each pixel
-/// once; the panel and the corner readouts cover about a third of a 1280x720 window.
-fn drawn_rects(jobs: &[egui::ClippedPrimitive], pixels_per_point: f32, size: (u32, u32)) -> Vec<PixelRect> {
-    use egui::epaint::Primitive;
-    let mut rects: Vec<[f32; 4]> = jobs
-        .iter()
-        .filter_map(|j| match &j.primitive {
-            Primitive::Mesh(m) if m.indices.is_empty() => None,
-            Primitive::Mesh(m) => Some(m.calc_bounds().intersect(j.clip_rect)),
-            Primitive::Callback(_) => Some(j.clip_rect),
-        })
-        .map(|r| {
-            let (lo, hi) = (r.min * pixels_per_point, r.max * pixels_per_point);
-            [
-                lo.x.floor().max(0.0),
-                lo.y.floor().max(0.0),
-                hi.x.ceil().min(size.0 as f32),
-                hi.y.ceil().min(size.1 as f32),
-            ]
-        })
-        .filter(|r| r[0] < r[2] && r[1] < r[3])
-        .collect();
-    let overlap = |a: &[f32; 4], b: &[f32; 4]| a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
-    while let Some((i, k)) =
-        (0..rects.len()).find_map(|i| (i + 1..rects.len()).find(|&k| overlap(&rects[i], &rects[k])).map(|k| (i, k)))
-    {
-        let b = rects.swap_remove(k);
-        let a = &mut rects[i];
-        *a = [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])];
-    }
-    rects.iter().map(|r| [r[0] as u32, r[1] as u32, (r[2] - r[0]) as u32, (r[3] - r[1]) as u32]).collect()
 }
 
 /// True when two UI frames' meshes draw the same pixels: the same clip rectangles and meshes, in order (a
@@ -426,31 +389,6 @@ mod tests {
     }
 
     const WHOLE: [f32; 4] = [0.0, 0.0, 1000.0, 1000.0];
-
-    #[test]
-    fn drawn_rects_round_outward_clip_and_merge_overlaps() {
-        // Two points per pixel: the panel at the left, a corner box at the right, a tooltip over the panel,
-        // one mesh clipped away and an empty one.
-        let jobs = [
-            job([0.0, 0.0, 150.25, 360.0], WHOLE),
-            job([560.0, 4.0, 636.0, 40.0], WHOLE),
-            job([100.0, 300.0, 200.0, 320.0], WHOLE),
-            job([10.0, 10.0, 20.0, 20.0], [30.0, 30.0, 40.0, 40.0]),
-            ClippedPrimitive { clip_rect: Rect::EVERYTHING, primitive: Primitive::Mesh(Mesh::default()) },
-        ];
-        let mut rects = drawn_rects(&jobs, 2.0, (1280, 720));
-        rects.sort_unstable();
-        assert_eq!(rects, vec![[0, 0, 400, 720], [1120, 8, 152, 72]]);
-        let clipped = drawn_rects(&[job([0.0, 0.0, 900.0, 900.0], WHOLE)], 1.0, (640, 480));
-        assert_eq!(clipped, vec![[0, 0, 640, 480]], "the target's edges clip");
-        // A chain of overlaps merges into one rectangle even when only the union meets the last piece.
-        let chain = [
-            job([0.0, 0.0, 10.0, 50.0], WHOLE),
-            job([55.0, 40.0, 60.0, 60.0], WHOLE),
-            job([5.0, 5.0, 60.0, 6.0], WHOLE),
-        ];
-        assert_eq!(drawn_rects(&chain, 1.0, (100, 100)), vec![[0, 0, 60, 60]]);
-    }
 
     #[test]
     fn same_jobs_compares_meshes_and_clips() {

@@ -20,6 +20,7 @@ mod hybrid;
 mod lab;
 mod loader;
 mod settings;
+mod ui_cover;
 mod worker;
 
 use std::process::ExitCode;
