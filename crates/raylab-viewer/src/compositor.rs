@@ -1,7 +1,8 @@
 //! Putting a window together on the GPU: the traced frame uploaded with `queue.write_texture` and drawn as a
 //! full-target triangle (`shaders/frame.wgsl`), then the egui panels over it.
 //!
-//! egui's output is drawn into a texture of its own (the UI layer), which is laid over the frame where egui
+//! egui's output is drawn into a texture of its own (the UI layer; its opaque base, the side panel's
+//! background, filled without egui's shader, [`crate::ui_fill`]), which is laid over the frame where egui
 //! drew (the cells its triangles touch, [`crate::ui_cover`]); its meshes are uploaded and drawn again only when they changed. A redraw of the unchanged UI, the
 //! common case while frames stream in or the UI is asked to redraw often, then costs one full-target copy and
 //! a blend of the UI's pixels. It matters most on software Vulkan (lavapipe), where egui's fragment shader
@@ -10,6 +11,7 @@
 
 use crate::gpu::Gpu;
 use crate::ui_cover::{PixelRect, drawn_rects};
+use crate::ui_fill::{SolidBase, split_solid_base};
 
 /// Format of the frame texture: display-ready 8-bit values.
 pub const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -56,6 +58,13 @@ pub fn fullscreen_pipeline(
     })
 }
 
+/// The texture [`Compositor`] fills the UI's solid base from, and the colour it holds.
+struct BaseFill {
+    texture: wgpu::Texture,
+    bind_group: wgpu::BindGroup,
+    color: Option<[u8; 4]>,
+}
+
 /// The uploaded frame.
 struct FrameTexture {
     texture: wgpu::Texture,
@@ -95,8 +104,14 @@ pub struct Compositor {
     params: wgpu::Buffer,
     frame: Option<FrameTexture>,
     ui: Option<UiLayer>,
-    /// The meshes and screen (size in pixels, pixels per point) last handed to egui's renderer.
+    /// The meshes and screen (size in pixels, pixels per point) last handed to [`Compositor::prepare_egui`].
     ui_jobs: Vec<egui::ClippedPrimitive>,
+    /// Their solid base, which the compositor fills itself ([`crate::ui_fill`]), and the meshes egui's
+    /// renderer draws: the rest.
+    ui_base: Option<SolidBase>,
+    ui_drawn: Vec<egui::ClippedPrimitive>,
+    /// A one-texel texture of the base's colour, drawn through `frame.wgsl`.
+    base_fill: Option<BaseFill>,
     ui_screen: Option<([u32; 2], f32)>,
     /// egui's output (meshes, screen or textures) changed since the UI layer was drawn.
     ui_stale: bool,
@@ -163,6 +178,9 @@ impl Compositor {
             frame: None,
             ui: None,
             ui_jobs: Vec::new(),
+            ui_base: None,
+            ui_drawn: Vec::new(),
+            base_fill: None,
             ui_screen: None,
             ui_stale: false,
             ui_draws: 0,
@@ -294,7 +312,41 @@ impl Compositor {
         self.ui_stale = true;
         self.ui_screen = Some(key);
         self.ui_jobs = jobs.to_vec();
-        self.egui.update_buffers(device, queue, encoder, jobs, screen)
+        let size = (screen.size_in_pixels[0], screen.size_in_pixels[1]);
+        (self.ui_base, self.ui_drawn) = split_solid_base(jobs, screen.pixels_per_point, size);
+        self.egui.update_buffers(device, queue, encoder, &self.ui_drawn, screen)
+    }
+
+    /// The one-texel texture of `color` (made on first use, rewritten when the colour changes).
+    fn base_fill(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, color: [u8; 4]) {
+        if self.base_fill.is_none() {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("ui base fill"),
+                size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: FRAME_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            let bind_group = self.bind_texture(device, "ui base fill", &texture);
+            self.base_fill = Some(BaseFill { texture, bind_group, color: None });
+        }
+        if let Some(fill) = self.base_fill.as_mut().filter(|f| f.color != Some(color)) {
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &fill.texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &color,
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4), rows_per_image: Some(1) },
+                wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+            );
+            fill.color = Some(color);
+        }
     }
 
     /// Frees the textures egui no longer needs; call after the UI frame was submitted.
@@ -323,9 +375,25 @@ impl Compositor {
         params[4..8].copy_from_slice(&(size.1 as f32).to_le_bytes());
         queue.write_buffer(&self.params, 0, &params);
         let made = self.ensure_ui_layer(device, size, screen.pixels_per_point);
-        if let Some(layer) = self.ui.as_mut().filter(|_| made || self.ui_stale) {
+        let redraw = made || self.ui_stale;
+        if let Some(base) = self.ui_base.filter(|_| redraw) {
+            self.base_fill(device, queue, base.color);
+        }
+        if let Some(layer) = self.ui.as_mut().filter(|_| redraw) {
             let mut pass = target_pass(encoder, "ui layer", &layer.view, wgpu::Color::TRANSPARENT);
-            self.egui.render(&mut pass, jobs, screen);
+            // The base first (nothing of egui's lies below it), then the rest of egui's output over it.
+            if let (Some(base), Some(fill)) = (self.ui_base, &self.base_fill) {
+                let [x, y, w, h] = base.rect;
+                let (x, y) = (x.min(size.0), y.min(size.1));
+                let (w, h) = (w.min(size.0 - x), h.min(size.1 - y));
+                if w > 0 && h > 0 {
+                    pass.set_pipeline(&self.pipeline);
+                    pass.set_bind_group(0, &fill.bind_group, &[]);
+                    pass.set_scissor_rect(x, y, w, h);
+                    pass.draw(0..3, 0..1);
+                }
+            }
+            self.egui.render(&mut pass, &self.ui_drawn, screen);
             layer.rects = drawn_rects(jobs, screen.pixels_per_point, size);
             self.ui_stale = false;
             self.ui_draws += 1;

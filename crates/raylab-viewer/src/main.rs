@@ -21,6 +21,7 @@ mod lab;
 mod loader;
 mod settings;
 mod ui_cover;
+mod ui_fill;
 mod worker;
 
 use std::process::ExitCode;
