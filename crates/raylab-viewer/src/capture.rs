@@ -4,12 +4,12 @@
 use crate::compositor::Compositor;
 use crate::gpu::Gpu;
 
-/// Draws the window's contents offscreen at `size` and returns them as an RGBA image.
+/// Draws the window's contents (the latest frame and the UI last handed to [`Compositor::prepare_egui`])
+/// offscreen at `size` and returns them as an RGBA image.
 pub fn capture(
     gpu: &Gpu,
     compositor: &mut Compositor,
     size: (u32, u32),
-    jobs: &[egui::ClippedPrimitive],
     screen: &egui_wgpu::ScreenDescriptor,
 ) -> Result<image::RgbaImage, String> {
     let (device, queue) = (&gpu.device, &gpu.queue);
@@ -33,7 +33,7 @@ pub fn capture(
         mapped_at_creation: false,
     });
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("screenshot") });
-    compositor.draw(gpu, &mut encoder, &view, (w, h), jobs, screen);
+    compositor.draw(gpu, &mut encoder, &view, (w, h), screen);
     encoder.copy_texture_to_buffer(
         wgpu::TexelCopyTextureInfo {
             texture: &texture,

@@ -3,9 +3,9 @@
 //!
 //! egui's output is drawn into a texture of its own (the UI layer; its opaque base, the side panel's
 //! background, filled without egui's shader, [`crate::ui_fill`]), which is laid over the frame where egui
-//! drew (the cells its triangles touch, [`crate::ui_cover`]); its meshes are uploaded and drawn again only when they changed. A redraw of the unchanged UI, the
-//! common case while frames stream in or the UI is asked to redraw often, then costs one full-target copy and
-//! a blend of the UI's pixels. It matters most on software Vulkan (lavapipe), where egui's fragment shader
+//! drew (the cells its triangles touch, [`crate::ui_cover`]); its meshes are uploaded and drawn again only
+//! when they changed. A redraw of the unchanged UI, the common case while frames stream in or the UI is asked
+//! to redraw often, then costs one full-target copy and a blend of the UI's pixels. It matters most on software Vulkan (lavapipe), where egui's fragment shader
 //! costs tens of milliseconds of CPU per draw of a 1280x720 window with the panel, time taken from the tracer
 //! on the same cores.
 
@@ -356,8 +356,8 @@ impl Compositor {
         }
     }
 
-    /// Draws the latest frame and the UI into `target` (of `size` pixels and of this compositor's format), `jobs`
-    /// being the meshes last handed to [`Compositor::prepare_egui`]. The UI layer is drawn again first when
+    /// Draws the latest frame and the UI into `target` (of `size` pixels and of this compositor's format): the
+    /// meshes last handed to [`Compositor::prepare_egui`]. The UI layer is drawn again first when
     /// egui's output or the target's size changed.
     pub fn draw(
         &mut self,
@@ -365,7 +365,6 @@ impl Compositor {
         encoder: &mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
         size: (u32, u32),
-        jobs: &[egui::ClippedPrimitive],
         screen: &egui_wgpu::ScreenDescriptor,
     ) {
         let (device, queue) = (&gpu.device, &gpu.queue);
@@ -394,7 +393,7 @@ impl Compositor {
                 }
             }
             self.egui.render(&mut pass, &self.ui_drawn, screen);
-            layer.rects = drawn_rects(jobs, screen.pixels_per_point, size);
+            layer.rects = drawn_rects(&self.ui_jobs, screen.pixels_per_point, size);
             self.ui_stale = false;
             self.ui_draws += 1;
         }

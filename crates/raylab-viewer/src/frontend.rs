@@ -112,7 +112,7 @@ impl Frontend {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ui") });
         let extra = self.compositor.prepare_egui(device, queue, &mut encoder, &frame.jobs, &frame.screen);
-        self.compositor.draw(&self.gpu, &mut encoder, target, size, &frame.jobs, &frame.screen);
+        self.compositor.draw(&self.gpu, &mut encoder, target, size, &frame.screen);
         queue.submit(extra.into_iter().chain([encoder.finish()]));
         frame.cost = frame.cost.plus(stamp.cost());
     }
@@ -133,7 +133,7 @@ impl Frontend {
     /// Draws `frame` offscreen and writes it as PNG.
     pub fn screenshot(&mut self, frame: &UiFrame, path: &std::path::Path) -> Result<(), String> {
         let size = (frame.screen.size_in_pixels[0], frame.screen.size_in_pixels[1]);
-        let img = capture(&self.gpu, &mut self.compositor, size, &frame.jobs, &frame.screen)?;
+        let img = capture(&self.gpu, &mut self.compositor, size, &frame.screen)?;
         img.save(path).map_err(|e| format!("cannot write {}: {e}", path.display()))
     }
 }

@@ -58,7 +58,7 @@ fn solid_base(mesh: &Mesh, clip: Rect, ppp: f32, size: (u32, u32)) -> Option<(So
     let mut area = 0.0f64;
     for t in mesh.indices.chunks_exact(3).filter_map(corners).filter(of_base) {
         let [a, b, c] = t.map(|v| v.pos);
-        bounds = bounds.union(Rect::from_min_max(a.min(b).min(c), a.max(b).max(c)));
+        bounds = bounds.union(tri_bounds(&t));
         area += 0.5 * (((b - a).x * (c - a).y - (b - a).y * (c - a).x) as f64).abs();
     }
     // They must tile their bounds exactly.
@@ -77,12 +77,12 @@ fn solid_base(mesh: &Mesh, clip: Rect, ppp: f32, size: (u32, u32)) -> Option<(So
         if of_base(&vs) {
             continue;
         }
-        let [a, b, c] = vs.map(|v| v.pos);
-        if inside(Rect::from_min_max(a.min(b).min(c), a.max(b).max(c))) {
+        let r = tri_bounds(&vs);
+        if inside(r) {
             return None;
         }
         if vs.iter().any(|v| v.color.a() == 0) {
-            ring = ring.union(Rect::from_min_max(a.min(b).min(c), a.max(b).max(c)));
+            ring = ring.union(r);
         }
         kept.extend_from_slice(t);
     }
@@ -104,6 +104,12 @@ fn solid_base(mesh: &Mesh, clip: Rect, ppp: f32, size: (u32, u32)) -> Option<(So
     }
     let rect = [cx0 as u32, cy0 as u32, (cx1 - cx0) as u32, (cy1 - cy0) as u32];
     Some((SolidBase { rect, color: color.to_array() }, kept))
+}
+
+/// The bounds of a triangle's corners.
+fn tri_bounds(t: &[&Vertex; 3]) -> Rect {
+    let [a, b, c] = t.map(|v| v.pos);
+    Rect::from_min_max(a.min(b).min(c), a.max(b).max(c))
 }
 
 /// Whether `ring` (the bounds of a mesh's fading triangles) reaches beyond `rect` on every side: egui's
