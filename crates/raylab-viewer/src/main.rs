@@ -20,6 +20,7 @@ mod hybrid;
 mod lab;
 mod loader;
 mod settings;
+mod tracer_priority;
 mod ui_cover;
 mod ui_fill;
 mod worker;

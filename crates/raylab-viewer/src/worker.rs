@@ -1,5 +1,5 @@
 //! The render worker: one thread that owns a rayon pool of the chosen size and traces the latest requested
-//! frame at the lowest thread priority, so the window's event loop never waits for the tracer. Requests replace each other (only the
+//! frame below the UI's thread priority ([`TracerPriority`]), so the window's event loop never waits for the tracer. Requests replace each other (only the
 //! newest matters); in continuous mode the last view is traced again and again to give steady FPS readings.
 
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -29,6 +29,7 @@ use crate::compare::{CompareRow, compare_configs};
 use crate::hybrid::readback::GBufferImage;
 use crate::loader::LoadedScene;
 use crate::settings::{RenderMode, ViewerSettings};
+use crate::tracer_priority::TracerPriority;
 
 /// One frame to trace.
 #[derive(Clone)]
@@ -196,9 +197,10 @@ impl Worker {
         let shared = Arc::new(Shared { state: Mutex::new(State::default()), wake_worker: Condvar::new() });
         let (tx, events) = mpsc::channel();
         let s = Arc::clone(&shared);
+        let priority = TracerPriority::below_caller();
         let thread = std::thread::Builder::new()
             .name("raylab-render".into())
-            .spawn(move || run(&s, &tx, &wake))
+            .spawn(move || run(&s, &tx, &wake, priority))
             .expect("the operating system refused to start the render thread");
         Self { shared, events, thread: Some(thread) }
     }
@@ -252,16 +254,9 @@ impl Drop for Worker {
     }
 }
 
-/// Puts the calling thread below the UI in the scheduler's eyes (lowest niceness), so that the window stays
-/// responsive while the tracer keeps every core busy. Lowering a priority needs no privilege; should the
-/// system refuse anyway, the thread simply keeps its priority.
-fn lower_priority() {
-    let _ = thread_priority::set_current_thread_priority(thread_priority::ThreadPriority::Min);
-}
-
-/// The worker's loop.
-fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
-    lower_priority();
+/// The worker's loop; it and its pool's threads run at `priority`.
+fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn(), priority: TracerPriority) {
+    priority.apply();
     let mut pool: Option<(usize, rayon::ThreadPool)> = None;
     let mut progressive: Option<Progressive> = None;
     let mut animated: Option<AnimatedScene> = None;
@@ -289,7 +284,7 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn()) {
         let threads = job.settings.threads.max(1);
         if pool.as_ref().is_none_or(|(n, _)| *n != threads) {
             let pool_result =
-                rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| lower_priority()).build();
+                rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(move |_| priority.apply()).build();
             match pool_result {
                 Ok(p) => pool = Some((threads, p)),
                 Err(e) => {
