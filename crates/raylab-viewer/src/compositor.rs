@@ -11,7 +11,7 @@
 
 use crate::gpu::Gpu;
 use crate::ui_cover::{PixelRect, drawn_rects};
-use crate::ui_fill::{SolidBase, split_solid_base};
+use crate::ui_fill::{SolidBase, around, split_solid_base};
 
 /// Format of the frame texture: display-ready 8-bit values.
 pub const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -80,6 +80,8 @@ struct UiLayer {
     pixels_per_point: f32,
     /// The pixels egui drew, as disjoint rectangles (see [`drawn_rects`]).
     rects: Vec<PixelRect>,
+    /// Where the layer is opaque (its solid base, see [`crate::ui_fill`]): the frame below is hidden there.
+    opaque: Option<PixelRect>,
 }
 
 /// True when two UI frames' meshes draw the same pixels: the same clip rectangles and meshes, in order (a
@@ -272,7 +274,7 @@ impl Compositor {
         });
         let bind_group = self.bind_texture(device, "ui layer", &texture);
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        self.ui = Some(UiLayer { view, bind_group, size, pixels_per_point, rects: Vec::new() });
+        self.ui = Some(UiLayer { view, bind_group, size, pixels_per_point, rects: Vec::new(), opaque: None });
         true
     }
 
@@ -381,6 +383,7 @@ impl Compositor {
         if let Some(layer) = self.ui.as_mut().filter(|_| redraw) {
             let mut pass = target_pass(encoder, "ui layer", &layer.view, wgpu::Color::TRANSPARENT);
             // The base first (nothing of egui's lies below it), then the rest of egui's output over it.
+            layer.opaque = None;
             if let (Some(base), Some(fill)) = (self.ui_base, &self.base_fill) {
                 let [x, y, w, h] = base.rect;
                 let (x, y) = (x.min(size.0), y.min(size.1));
@@ -390,6 +393,7 @@ impl Compositor {
                     pass.set_bind_group(0, &fill.bind_group, &[]);
                     pass.set_scissor_rect(x, y, w, h);
                     pass.draw(0..3, 0..1);
+                    layer.opaque = Some([x, y, w, h]);
                 }
             }
             self.egui.render(&mut pass, &self.ui_drawn, screen);
@@ -401,7 +405,18 @@ impl Compositor {
         if let Some(f) = &self.frame {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &f.bind_group, &[]);
-            pass.draw(0..3, 0..1);
+            // The layer's opaque base, laid over the frame below, would hide the frame there: skip it. Its
+            // rectangles (cells egui's triangles touch, the base's among them) cover the base.
+            let hidden = self.ui.as_ref().filter(|l| !l.rects.is_empty()).and_then(|l| l.opaque);
+            match hidden {
+                Some(opaque) => {
+                    for [x, y, w, h] in around(opaque, size) {
+                        pass.set_scissor_rect(x, y, w, h);
+                        pass.draw(0..3, 0..1);
+                    }
+                }
+                None => pass.draw(0..3, 0..1),
+            }
         }
         if let Some(layer) = self.ui.as_ref().filter(|l| !l.rects.is_empty()) {
             pass.set_pipeline(&self.layer_pipeline);

@@ -106,6 +106,23 @@ fn solid_base(mesh: &Mesh, clip: Rect, ppp: f32, size: (u32, u32)) -> Option<(So
     Some((SolidBase { rect, color: color.to_array() }, kept))
 }
 
+/// The parts of a `size` target outside `rect` (which may reach past the target), as at most four disjoint
+/// rectangles: the bands above and below it across the whole width, and the parts left and right of it beside
+/// it. Under the UI layer's opaque base the traced frame is hidden, so the compositor draws the frame here
+/// alone (at 512x512 the side panel covers two thirds of the window).
+pub fn around(rect: PixelRect, size: (u32, u32)) -> Vec<PixelRect> {
+    let [x, y, w, h] = rect;
+    let (x0, y0) = (x.min(size.0), y.min(size.1));
+    let (x1, y1) = (x.saturating_add(w).min(size.0), y.saturating_add(h).min(size.1));
+    if x0 >= x1 || y0 >= y1 {
+        return vec![[0, 0, size.0, size.1]];
+    }
+    [[0, 0, size.0, y0], [0, y1, size.0, size.1 - y1], [0, y0, x0, y1 - y0], [x1, y0, size.0 - x1, y1 - y0]]
+        .into_iter()
+        .filter(|r| r[2] > 0 && r[3] > 0)
+        .collect()
+}
+
 /// The bounds of a triangle's corners.
 fn tri_bounds(t: &[&Vertex; 3]) -> Rect {
     let [a, b, c] = t.map(|v| v.pos);
@@ -187,6 +204,34 @@ mod tests {
         let jobs = vec![ClippedPrimitive { clip_rect: Rect::EVERYTHING, primitive: Primitive::Mesh(mesh) }];
         assert_eq!(split_solid_base(&jobs, 1.0, (200, 200)).0, None);
         assert_eq!(split_solid_base(&[], 1.0, (200, 200)).0, None);
+    }
+
+    #[test]
+    fn around_a_rectangle_covers_every_other_pixel_once() {
+        let size = (37, 23);
+        let cases = [[0, 0, 12, 23], [5, 4, 10, 7], [30, 0, 20, 23], [0, 20, 37, 3], [0, 0, 37, 23], [40, 5, 3, 3]];
+        for rect in cases.into_iter().chain([[2, 3, 0, 5], [u32::MAX, 1, 5, 5]]) {
+            let mut count = vec![0u32; (size.0 * size.1) as usize];
+            for [x, y, w, h] in around(rect, size) {
+                assert!(w > 0 && h > 0 && x + w <= size.0 && y + h <= size.1, "{rect:?}: {:?}", [x, y, w, h]);
+                for py in y..y + h {
+                    for px in x..x + w {
+                        count[(py * size.0 + px) as usize] += 1;
+                    }
+                }
+            }
+            let inside = |px: u32, py: u32| {
+                let [x, y, w, h] = rect.map(u64::from);
+                let (px, py) = (u64::from(px), u64::from(py));
+                px >= x && px < x + w && py >= y && py < y + h
+            };
+            for py in 0..size.1 {
+                for px in 0..size.0 {
+                    let want = u32::from(!inside(px, py));
+                    assert_eq!(count[(py * size.0 + px) as usize], want, "{rect:?}: pixel ({px}, {py})");
+                }
+            }
+        }
     }
 
     #[test]
