@@ -1,6 +1,7 @@
 //! The render worker: one thread that owns a rayon pool of the chosen size and traces the latest requested
-//! frame below the UI's thread priority ([`TracerPriority`]), so the window's event loop never waits for the tracer. Requests replace each other (only the
-//! newest matters); in continuous mode the last view is traced again and again to give steady FPS readings.
+//! frame below the UI's thread priority ([`TracerPriority`]), so the window's event loop never waits for the
+//! tracer. Requests replace each other (only the newest matters); in continuous mode the last view is traced
+//! again and again to give steady FPS readings.
 
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
