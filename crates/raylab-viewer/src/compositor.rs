@@ -5,9 +5,10 @@
 //! background, filled without egui's shader, [`crate::ui_fill`]), which is laid over the frame where egui
 //! drew (the cells its triangles touch, [`crate::ui_cover`]); its meshes are uploaded and drawn again only
 //! when they changed. A redraw of the unchanged UI, the common case while frames stream in or the UI is asked
-//! to redraw often, then costs one full-target copy and a blend of the UI's pixels. It matters most on software Vulkan (lavapipe), where egui's fragment shader
-//! costs tens of milliseconds of CPU per draw of a 1280x720 window with the panel, time taken from the tracer
-//! on the same cores.
+//! to redraw often, then costs a copy of the frame around the opaque base (which would hide it) and a blend of
+//! the UI's pixels. It matters most on software Vulkan (lavapipe), where egui's fragment shader costs tens of
+//! milliseconds of CPU per draw of a 1280x720 window with the panel, time taken from the tracer on the same
+//! cores.
 
 use crate::gpu::Gpu;
 use crate::ui_cover::{PixelRect, drawn_rects};
