@@ -159,6 +159,15 @@ impl TriangleSoup {
         &self.verts[i as usize]
     }
 
+    /// Starts loading the corners of triangle `i` into the caches: both cache lines when its 36 bytes
+    /// straddle a line boundary. A hint only; it changes no result.
+    #[inline(always)]
+    pub fn prefetch(&self, i: u32) {
+        let [first, _, last] = &self.verts[i as usize];
+        raylab_simd::prefetch(std::slice::from_ref(first));
+        raylab_simd::prefetch(std::slice::from_ref(last));
+    }
+
     /// The corners of triangles `range`, side by side.
     #[inline]
     pub fn slice(&self, range: std::ops::Range<usize>) -> &[[Vec3; 3]] {
