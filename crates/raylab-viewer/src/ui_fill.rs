@@ -110,17 +110,16 @@ fn solid_base(mesh: &Mesh, clip: Rect, ppp: f32, size: (u32, u32)) -> Option<(So
 /// rectangles: the bands above and below it across the whole width, and the parts left and right of it beside
 /// it. Under the UI layer's opaque base the traced frame is hidden, so the compositor draws the frame here
 /// alone (at 512x512 the side panel covers two thirds of the window).
-pub fn around(rect: PixelRect, size: (u32, u32)) -> Vec<PixelRect> {
+pub fn around(rect: PixelRect, size: (u32, u32)) -> impl Iterator<Item = PixelRect> {
     let [x, y, w, h] = rect;
     let (x0, y0) = (x.min(size.0), y.min(size.1));
     let (x1, y1) = (x.saturating_add(w).min(size.0), y.saturating_add(h).min(size.1));
-    if x0 >= x1 || y0 >= y1 {
-        return vec![[0, 0, size.0, size.1]];
-    }
-    [[0, 0, size.0, y0], [0, y1, size.0, size.1 - y1], [0, y0, x0, y1 - y0], [x1, y0, size.0 - x1, y1 - y0]]
-        .into_iter()
-        .filter(|r| r[2] > 0 && r[3] > 0)
-        .collect()
+    let parts = if x0 >= x1 || y0 >= y1 {
+        [[0, 0, size.0, size.1], [0; 4], [0; 4], [0; 4]]
+    } else {
+        [[0, 0, size.0, y0], [0, y1, size.0, size.1 - y1], [0, y0, x0, y1 - y0], [x1, y0, size.0 - x1, y1 - y0]]
+    };
+    parts.into_iter().filter(|r| r[2] > 0 && r[3] > 0)
 }
 
 /// The bounds of a triangle's corners.

@@ -96,6 +96,7 @@ impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32) {
         // One set of batched verdicts for the four frustums: their packets share chunks.
         let batch = &mut BatchBits::<4>::default();
+        leaf.prefetch_triangles();
         for (i, chunks) in self.chunks.iter().enumerate() {
             let leaf = Leaf { near: near[i], ..*leaf };
             if active >> i & 1 == 1 && leaf_intersect(&leaf, self.tile, chunks, self.cull, batch, stats) {
