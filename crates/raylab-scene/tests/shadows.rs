@@ -206,7 +206,7 @@ fn packet_edge_widths_equal_single_walks() {
     }
 }
 
-/// Edge-width walks of the bundled methods (the blocked segments of a tile, which end at the light, walked as
+/// Edge-width walks of the bundled methods (the segments of a tile, which end at the light, walked as
 /// one frustum or cone from there) give each ray the occlusion of its single walk, on every backend, with
 /// culling on and off: groups of one to a few hundred segments from around random spots, some right under
 /// the light (direction signs mixed inside one bundle, zero components) and some too wide for a bundle

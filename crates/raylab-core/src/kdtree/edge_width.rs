@@ -11,8 +11,8 @@
 //! ([`Front::Signs`]). A lane's crossings are those the single walk finds (the packet triangle test repeats
 //! the scalar test's arithmetic per lane), so both give the same occlusion.
 //!
-//! Bundle walks trace all the blocked segments of a tile at once, as one frustum or cone walk from the
-//! light the segments end at (the bundles hard shadows use): the tree is descended once for the tile rather
+//! Bundle walks trace all the segments of a tile at once, as one frustum or cone walk from the light the
+//! segments end at (the bundles hard shadows use): the tree is descended once for the tile rather
 //! than once per packet, and each leaf is tested against the packets that reach its box. Leaves then come
 //! in the light's order, not in each lane's, so a lane gathers all its crossings and pairs them once at the
 //! end, as the brute-force reference does; the single walk's early stop (a chord of at least R) only skips

@@ -2,10 +2,10 @@
 //!
 //! Hard shadows go through the frame's traversal method as one tile of segments ending at the light (so the
 //! frustum methods trace them as frustums from the light, as the thesis does); the shadow cache is a
-//! single-ray technique (DACRT, which traces sets, consults the cache for a whole layer at once); edge widths
-//! start as hard shadows, and the blocked segments then walk the kd-tree for their widths: one ray at a time
-//! under the single-ray methods, as one frustum or cone from the light for a tile with many of them under
-//! the bundled methods, else in packets; multi-sampling traces each point's samples as one bundle: plain packets
+//! single-ray technique (DACRT, which traces sets, consults the cache for a whole layer at once); for edge
+//! widths every segment walks the kd-tree, in Morton order over the layer: one ray at a time under the
+//! single-ray methods, as one frustum or cone from the light for a tile with many of them under the bundled
+//! methods, else in packets; multi-sampling traces each point's samples as one bundle: plain packets
 //! (shared by neighbouring points when their samples are fewer than a packet's lanes), a pyramid fitted to
 //! them, or a pyramid or cone around the light built before the samples ([`crate::trace::Proxy`]).
 
@@ -19,6 +19,7 @@ use crate::shadow::{EdgeWidth, LightSamples, SampleBound, ShadowCache, Shadows};
 use crate::stats::TraversalStats;
 use crate::trace::{Proxy, TileScratch, Tracer};
 
+use super::order::RayOrder;
 use super::shade::{Surface, shadow_ray};
 
 /// State of the shadow techniques (the shadow cache, edge-width buffers, light samples), reused from
@@ -32,7 +33,11 @@ pub struct ShadowScratch {
     /// Where each point's rays start in `rays`, and how many there are (`None`: no point, or it faces away).
     starts: Vec<Option<(usize, usize)>>,
     blocked: Vec<bool>,
+    /// The edge-width walks' segments, in [`ShadowScratch::gather_walks`]'s order, and their pixels.
     walks: Vec<Ray>,
+    walk_pixels: Vec<usize>,
+    /// A layer's pixels in Morton order, and the layer size they are for.
+    morton: ((usize, usize), Vec<usize>),
     widths: Vec<f32>,
 }
 
@@ -53,6 +58,25 @@ impl ShadowScratch {
     /// (kept, it would cost every lit ray of the new tile a test that rarely succeeds).
     pub fn start_tile(&mut self) {
         self.cache = ShadowCache::default();
+    }
+
+    /// Fills `walks` and `walk_pixels` with the segments of `rays` (a `width x height` layer) in Morton order,
+    /// so that the walks' packets and bundles, which take consecutive segments, hold compact blocks of
+    /// pixels rather than strips of rows (a 4x4 block for sixteen lanes): walked in row order, Sponza's
+    /// edge-width shadow stage took about 1.1x as long (docs/BENCHMARKS.md, shading readings).
+    fn gather_walks(&mut self, width: usize, height: usize) {
+        if self.morton.0 != (width, height) {
+            let order = RayOrder::Morton.offsets(width as u32, height as u32);
+            self.morton = ((width, height), order.iter().map(|&(x, y)| y as usize * width + x as usize).collect());
+        }
+        self.walks.clear();
+        self.walk_pixels.clear();
+        for &k in &self.morton.1 {
+            if let Some(r) = self.rays[k] {
+                self.walks.push(r);
+                self.walk_pixels.push(k);
+            }
+        }
     }
 }
 
@@ -118,15 +142,16 @@ impl ShadowTracer<'_> {
                 })
                 .collect(),
             Shadows::EdgeWidth { radius, leak_fix } => {
-                // A segment nothing blocks has no crossing and a visibility of 1: the frame's method finds
-                // those as hard shadows, coherently, and only the blocked ones walk the tree for edge widths.
-                self.hard(surfaces, (width, height), stats, sc);
+                // Every segment walks the tree: one that nothing blocks finds no crossing and sees the whole
+                // light. A hard-shadow pass first, to walk only the blocked ones, cost more than it saved
+                // (docs/BENCHMARKS.md, shading readings).
+                sc.rays.clear();
+                sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(to_center)));
                 // Scratch outlives frames (see `render`), whose edge settings may differ.
                 if sc.edge.first().is_none_or(|e| e.settings() != (radius, leak_fix)) {
                     sc.edge.clear();
                 }
-                sc.walks.clear();
-                sc.walks.extend(sc.rays.iter().zip(&sc.blocked).filter_map(|(r, &b)| r.filter(|_| b)));
+                sc.gather_walks(width, height);
                 let states = sc.walks.len().max(MAX_LANES);
                 if sc.edge.len() < states {
                     sc.edge.resize(states, EdgeWidth::new(radius, leak_fix));
@@ -134,16 +159,11 @@ impl ShadowTracer<'_> {
                 sc.widths.clear();
                 sc.widths.resize(sc.walks.len(), 0.0);
                 self.tracer.edge_widths(&sc.walks, Some(center), &mut sc.edge, &mut sc.widths, stats);
-                let mut widths = sc.widths.iter();
-                sc.rays
-                    .iter()
-                    .zip(&sc.blocked)
-                    .map(|(r, &blocked)| match (r, blocked) {
-                        (Some(_), true) => 1.0 - widths.next().copied().unwrap_or(1.0),
-                        (Some(_), false) => 1.0,
-                        (None, _) => 0.0,
-                    })
-                    .collect()
+                let mut visible = vec![0.0; sc.rays.len()];
+                for (&k, &w) in sc.walk_pixels.iter().zip(&sc.widths) {
+                    visible[k] = 1.0 - w;
+                }
+                visible
             }
             Shadows::MultiSample { samples, bound } => {
                 let mut out = Vec::with_capacity(surfaces.len());
@@ -302,5 +322,40 @@ impl Kernel for MultiSampled<'_, '_> {
     fn run<V: Vf32>(self) {
         let tracer = self.st.tracer.with_method(self.bound.method());
         self.trace_with(&mut SimdBundles::<V> { tracer, scratch: TileScratch::default() });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    /// Edge-width walks take every segment of a layer once, in Morton order, and know its pixel.
+    #[test]
+    fn walks_cover_each_segment_once_in_morton_order() {
+        let (width, height) = (5, 3);
+        let ray = |k: usize| Ray::new(Vec3::new(k as f32, 0.0, 0.0), Vec3::Y);
+        let mut sc = ShadowScratch {
+            rays: (0..width * height).map(|k| (k % 4 != 1).then(|| ray(k))).collect(),
+            ..ShadowScratch::default()
+        };
+        for (w, h) in [(width, height), (2, 1), (width, height)] {
+            let rays = sc.rays.clone();
+            sc.rays.truncate(w * h);
+            sc.gather_walks(w, h);
+            let want: Vec<usize> = RayOrder::Morton
+                .offsets(w as u32, h as u32)
+                .iter()
+                .map(|&(x, y)| y as usize * w + x as usize)
+                .filter(|&k| k % 4 != 1)
+                .collect();
+            assert_eq!(sc.walk_pixels, want, "{w}x{h}");
+            for (r, &k) in sc.walks.iter().zip(&sc.walk_pixels) {
+                assert_eq!(r.origin.x, k as f32, "{w}x{h}: the walk of pixel {k} holds another pixel's segment");
+            }
+            sc.rays = rays;
+        }
+        assert_eq!(sc.walk_pixels[..4], [0, 6, 2, 3], "two 2x2 blocks, pixels 1 and 5 empty");
     }
 }
