@@ -81,8 +81,16 @@ impl ShadowScratch {
 }
 
 impl ShadowTracer<'_> {
-    /// Hard shadows of a layer: fills `sc.rays` with the segments to the light's centre (`None` where there
-    /// is no surface or it faces away) and `sc.blocked` with their occlusion, traced by the frame's method.
+    /// Fills `sc.rays` with each surface's segment to the light's centre (`None` where there is no surface
+    /// or it faces away): the rays of hard shadows, of the shadow cache over sets and of edge widths.
+    fn segments_to_center(&self, surfaces: &[Option<Surface>], sc: &mut ShadowScratch) {
+        let center = self.light.position;
+        sc.rays.clear();
+        sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(|s| shadow_ray(s, center, center, self.epsilon))));
+    }
+
+    /// Hard shadows of a layer: fills `sc.rays` with the segments to the light's centre
+    /// ([`Self::segments_to_center`]) and `sc.blocked` with their occlusion, traced by the frame's method.
     fn hard(
         &self,
         surfaces: &[Option<Surface>],
@@ -90,13 +98,11 @@ impl ShadowTracer<'_> {
         stats: &mut TraversalStats,
         sc: &mut ShadowScratch,
     ) {
-        let center = self.light.position;
-        sc.rays.clear();
-        sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(|s| shadow_ray(s, center, center, self.epsilon))));
+        self.segments_to_center(surfaces, sc);
         sc.blocked.clear();
         sc.blocked.resize(sc.rays.len(), false);
         if sc.rays.iter().any(Option::is_some) {
-            self.tracer.occluded_tile(&sc.rays, width, height, Some(center), &mut sc.blocked, stats);
+            self.tracer.occluded_tile(&sc.rays, width, height, Some(self.light.position), &mut sc.blocked, stats);
         }
     }
 
@@ -127,8 +133,7 @@ impl ShadowTracer<'_> {
                 sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| if r.is_some() && !b { 1.0 } else { 0.0 }).collect()
             }
             Shadows::Cached if self.tracer.options.method.uses_dacrt() => {
-                sc.rays.clear();
-                sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(to_center)));
+                self.segments_to_center(surfaces, sc);
                 sc.blocked.clear();
                 sc.blocked.resize(sc.rays.len(), false);
                 sc.cache.occluded_set(self.tracer, &sc.rays, &mut sc.blocked, stats);
@@ -145,8 +150,7 @@ impl ShadowTracer<'_> {
                 // Every segment walks the tree: one that nothing blocks finds no crossing and sees the whole
                 // light. A hard-shadow pass first, to walk only the blocked ones, cost more than it saved
                 // (docs/BENCHMARKS.md, shading readings).
-                sc.rays.clear();
-                sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(to_center)));
+                self.segments_to_center(surfaces, sc);
                 // Scratch outlives frames (see `render`), whose edge settings may differ.
                 if sc.edge.first().is_none_or(|e| e.settings() != (radius, leak_fix)) {
                     sc.edge.clear();
