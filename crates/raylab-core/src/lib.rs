@@ -2,7 +2,7 @@
 //!
 //! Data flows one way through the modules: a [`scene::Scene`] is turned into an acceleration structure
 //! ([`kdtree::KdTree`]), rays from [`workload`] or the [`render`] tile loop are traced by a traversal kernel
-//! ([`kdtree::mono`], or the brute-force [`reference`]), and hits are shaded into a frame buffer. Counters
+//! ([`kdtree::mono`], or the brute-force [`reference`](mod@reference)), and hits are shaded into a frame buffer. Counters
 //! ([`stats::TraversalStats`]) travel with every trace so the CLI and the viewer report the same numbers as the
 //! thesis tables (Tsakok 2008, "Fast Ray Tracing Techniques", Tables 4.1-4.6).
 //!

@@ -1,8 +1,8 @@
 //! Divide-and-conquer ray tracing (DACRT: Mora 2011, "Naive ray-tracing: a divide-and-conquer approach", with
 //! Afra 2012's improvements; seed 003, Stokes 2014, section 2.5 and 3.3): rays are traced without any stored
 //! acceleration structure. A set of rays and a set of triangles are divided together: the triangles are split
-//! in two ([`split`]), the rays filtered against each half's box in SIMD ([`filter`]), and each half recursed
-//! with the rays that reach it ([`traverse`]), until few rays or few triangles are left to test naively.
+//! in two (`split.rs`), the rays filtered against each half's box in SIMD (`filter.rs`), and each half recursed
+//! with the rays that reach it (`traverse.rs`), until few rays or few triangles are left to test naively.
 //!
 //! The only preparation ([`Dacrt::new`]) copies the triangles and their boxes and makes the top of the
 //! division every call would begin with (sets above [`DIVIDE_ONCE_ABOVE`] triangles, a few linear passes), so

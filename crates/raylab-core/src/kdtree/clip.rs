@@ -22,7 +22,7 @@ pub fn clipped_bounds(tri: &[Vec3; 3], bx: &Aabb) -> Option<Aabb> {
     finish(tri, bx, extent)
 }
 
-/// [`clipped_bounds`] of `tri` in the two children of `bx` split at `coord[axis] = pos`: `(left, right)`.
+/// The clipped bounds (`clipped_bounds`, the test-only one-box reference) of `tri` in the two children of `bx` split at `coord[axis] = pos`: `(left, right)`.
 ///
 /// The triangle is clipped to `bx` once, and the polygon is then cut by the split plane in one pass over its
 /// edges that collects each side's vertices and the points where edges cross the plane (the clipping

@@ -2,7 +2,7 @@
 //! 4.1.2) with packet/leaf culling (4.1.4).
 //!
 //! A whole tile of rays with a common origin walks the tree as one interval `[near, far]` of distances from
-//! the origin: at a split the [`Frustum`] gives the range of distances at which its rays cross the plane,
+//! the origin: at a split the [`Frustum`](crate::packet::Frustum) gives the range of distances at which its rays cross the plane,
 //! the child on the origin's side is entered first, and the other child is pushed with the part of the
 //! interval that lies beyond the earliest crossing. At a leaf, each 2x2 packet is first tested against the
 //! leaf's box (culling, switchable) and then against the leaf's triangles. Entries on the stack that start

@@ -10,7 +10,7 @@
 //!
 //! Edge-width walks need each lane's leaves front to back, which the origin rule does not give when lanes
 //! start on both sides of a plane; their packets share direction signs and take the near child by sign
-//! ([`Front::Signs`]), the classic rule, under which every lane's cells come in its own distance order.
+//! (`Front::Signs`), the classic rule, under which every lane's cells come in its own distance order.
 //! Closest-hit and occlusion packets whose rays happen to share their signs (most coherent ones) walk the
 //! same way, with the classic interval step when no direction component is zero: the same intervals as the
 //! general step for such lanes, without its per-lane selects.

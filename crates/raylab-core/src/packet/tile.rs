@@ -182,7 +182,7 @@ pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -
 
 /// A bundle of rays from one origin, seen by the frustum walks only through the range of distances at which
 /// its rays cross an axis-aligned plane, which four factors per axis give by the side of the origin the plane
-/// lies on ([`sign_crossing`]): pyramid [`Frustum`]s and [`super::Cone`]s implement it.
+/// lies on (`sign_crossing`): pyramid [`Frustum`]s and [`super::Cone`]s implement it.
 pub trait Bundle {
     /// The common origin.
     fn origin(&self) -> Vec3;

@@ -90,7 +90,7 @@ impl EdgeWidth {
     /// (the far end of the leaf just visited; `f32::INFINITY` at the end of the ray). Returns true once the
     /// point is known to be fully occluded, so the traversal can stop.
     ///
-    /// Crossings at one place (within [`SAME_PLACE`]) form a group, handled the same whatever order they were
+    /// Crossings at one place (within `SAME_PLACE`) form a group, handled the same whatever order they were
     /// found in: same-facing members are one crossing; a group with both facings is an exit and an entry
     /// (inside) or an entry and an exit (outside, a graze).
     #[inline]

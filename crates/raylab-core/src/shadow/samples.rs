@@ -63,7 +63,7 @@ impl LightSamples {
 /// Shirley and Chiu's concentric map from the unit square to the unit disc.
 ///
 /// The angle of each wedge is a quarter turn at most, `pi/4 * ratio` with `|ratio| <= 1` (the second wedge's
-/// `pi/2 - pi/4 * ratio` swaps sine and cosine), so [`sin_cos_eighth`] computes it: `f32::sin_cos` was a
+/// `pi/2 - pi/4 * ratio` swaps sine and cosine), so `sin_cos_eighth` computes it: `f32::sin_cos` was a
 /// third of the cost of drawing a point's light samples.
 #[inline(always)]
 pub fn concentric_disc(p: Vec2) -> Vec2 {

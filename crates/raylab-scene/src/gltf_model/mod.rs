@@ -1,9 +1,9 @@
 //! The glTF 2.0 loader (the `gltf` crate): `.gltf` with external `.bin` files, `.glb`, and embedded data
 //! URIs; the node hierarchy with its transforms; triangle primitives (strips and fans converted, points and
-//! lines skipped with a warning); materials mapped onto the fixed-function model ([`materials`]); cameras as
+//! lines skipped with a warning); materials mapped onto the fixed-function model (`materials.rs`); cameras as
 //! named views and `KHR_lights_punctual` lights.
 //!
-//! Every accessor is checked against its buffer before it is read ([`data::check_accessor`]), every index
+//! Every accessor is checked against its buffer before it is read (`data::check_accessor`), every index
 //! against its vertex count, and every external reference must lie in the model's folder, so a hostile file
 //! gets an error naming it, never a panic.
 

@@ -1,6 +1,6 @@
 //! The full OBJ + MTL loader (tobj): polygons triangulated as fans, groups and objects, `mtllib`/`usemtl`,
 //! vertex normals (smooth ones generated with a crease angle when the file has none), texture coordinates, and
-//! the MTL materials mapped onto the fixed-function model ([`mtl`]) with their textures.
+//! the MTL materials mapped onto the fixed-function model (`mtl.rs`) with their textures.
 //!
 //! tobj reports errors without line numbers, so every line is first checked here: numbers that do not parse
 //! or are not finite, faces with fewer than three corners, and indices out of range are errors naming the
