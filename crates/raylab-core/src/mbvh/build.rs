@@ -8,20 +8,18 @@
 //!
 //! Each node first looks for an object split: 16 bins on each of the three axes of its references'
 //! centroids. Where the two halves of the best one overlap by more than [`SPATIAL_OVERLAP`] of the root's
-//! area (long or diagonal triangles, which make boxes overlap and rays visit both), it also bins space: 16
-//! equal slabs of the node's box per axis, each triangle cut into every slab it crosses. A plane between
-//! slabs may then cut triangles, which go to both sides as references clipped exactly to each
-//! ([`crate::kdtree::clip::split_clipped_bounds`], the kd-tree's perfect-split clipping). The cheaper split by
-//! the SAH wins; [`MbvhParams`] limits spatial splits to large nodes and bounds the copies they make. Embree's
+//! area (long or diagonal triangles, which make boxes overlap and rays visit both), it also bins space
+//! ([`super::spatial`]): 16 equal slabs of the node's box per axis, each triangle cut into every slab it
+//! crosses. A plane between slabs may then cut triangles, which go to both sides as references clipped
+//! exactly to each. The cheaper split by the SAH wins; [`MbvhParams`] limits spatial splits to large nodes and bounds the copies they make. Embree's
 //! high-quality builder, which the harness uses, makes the same kind of tree.
 
 use glam::{UVec3, Vec3, Vec3A};
-use rayon::prelude::*;
 
 use super::MbvhParams;
 use super::node::{EMPTY, MbvhNode};
-use crate::aabb::{Aabb, coord, coord_mut};
-use crate::kdtree::clip::split_clipped_bounds;
+use super::spatial::{SpatialSplit, best_spatial, partition_space};
+use crate::aabb::{Aabb, coord};
 use crate::tri4;
 
 /// Triangles per leaf above which a node is always split.
@@ -29,9 +27,9 @@ pub const MAX_LEAF: usize = 8;
 /// Most references [`Collapse`] merges into one leaf lane.
 const MAX_MERGED_LEAF: usize = 8;
 /// SAH bins per node and axis, for object and for spatial splits.
-const BINS: usize = 16;
+pub(super) const BINS: usize = 16;
 /// SAH cost of a node: one 4-box test, the unit of the SAH costs here.
-const C_TRAV: f32 = 1.0;
+pub(super) const C_TRAV: f32 = 1.0;
 /// SAH cost of one ray against a four-triangle block ([`tri4`]'s watertight test). Counting leaves by
 /// blocks rather than triangles (cost 1 each) makes leaves of up to four triangles: on Sponza's diffuse rays
 /// 4-box tests per single ray fall from 15.19 to 14.47 for 9.42 triangle tests instead of 5.31, single-ray
@@ -41,7 +39,7 @@ const C_BLOCK: f32 = 2.0;
 /// stack) stays shallow whatever the input: at most 48 SAH levels, then log2 of the rest.
 const MAX_SAH_DEPTH: u32 = 48;
 /// Nodes with at least this many references build their halves in parallel.
-const PARALLEL_MIN: usize = 4096;
+pub(super) const PARALLEL_MIN: usize = 4096;
 /// Spatial splits are tried where the best object split's halves overlap by at least this fraction of the
 /// root's surface area (Stich et al.'s alpha).
 const SPATIAL_OVERLAP: f32 = 1e-5;
@@ -49,9 +47,9 @@ const SPATIAL_OVERLAP: f32 = 1e-5;
 /// A triangle reference: a triangle and the part of its box inside the node that holds it (the whole box,
 /// unless spatial splits cut the triangle).
 #[derive(Clone, Copy)]
-struct Ref {
-    bounds: Aabb,
-    id: u32,
+pub(super) struct Ref {
+    pub(super) bounds: Aabb,
+    pub(super) id: u32,
 }
 
 impl Ref {
@@ -184,12 +182,12 @@ pub struct Built {
 }
 
 /// What every level of the build reads.
-struct Context<'a> {
-    tris: &'a [[Vec3; 3]],
+pub(super) struct Context<'a> {
+    pub(super) tris: &'a [[Vec3; 3]],
     /// Surface area of the root's box, the measure of [`SPATIAL_OVERLAP`].
-    root_area: f32,
+    pub(super) root_area: f32,
     /// Nodes with fewer references make object splits only.
-    spatial_min: usize,
+    pub(super) spatial_min: usize,
 }
 
 /// Builds over triangles given by their corners.
@@ -293,14 +291,14 @@ fn collapse(n: &Bin, at: usize, nodes: &mut Vec<MbvhNode>, ids: &mut Vec<u32>) {
 
 /// The box of some references and the box of their centroids.
 #[derive(Clone, Copy)]
-struct Extent {
-    bounds: Aabb,
-    centroids: Aabb,
+pub(super) struct Extent {
+    pub(super) bounds: Aabb,
+    pub(super) centroids: Aabb,
 }
 
 impl Extent {
     /// The extent of `refs`, by a pass over them.
-    fn of(refs: &[Ref]) -> Self {
+    pub(super) fn of(refs: &[Ref]) -> Self {
         refs.iter().fold(Extent { bounds: Aabb::EMPTY, centroids: Aabb::EMPTY }, |e, r| Extent {
             bounds: e.bounds.union(r.bounds),
             centroids: e.centroids.grow(r.centroid()),
@@ -309,7 +307,7 @@ impl Extent {
 }
 
 /// Two children's references and extents.
-type Parts = (Vec<Ref>, Extent, Vec<Ref>, Extent);
+pub(super) type Parts = (Vec<Ref>, Extent, Vec<Ref>, Extent);
 
 /// Builds the binary subtree over `refs` (spanning `extent`), which may hold at most `budget` references
 /// in all: what spatial splits may copy. An object split hands each child its extent, the reference boxes
@@ -422,195 +420,10 @@ fn partition_objects(refs: &mut Vec<Ref>, extent: &Extent, s: &Split) -> Option<
     Some((left, Extent { bounds: s.left, centroids: left_c }, right, Extent { bounds: s.right, centroids: right_c }))
 }
 
-/// Splits `refs` by the plane of `s`: a reference on one side goes there, one the plane cuts goes to both,
-/// clipped to each; `None` when one side would be empty.
-fn partition_space(ctx: &Context, refs: &[Ref], s: &SpatialSplit) -> Option<Parts> {
-    let (mut left, mut right) = (Vec::with_capacity(s.left_n), Vec::with_capacity(s.right_n));
-    for r in refs {
-        if coord(&r.bounds.max, s.axis) <= s.pos {
-            left.push(*r);
-        } else if coord(&r.bounds.min, s.axis) >= s.pos {
-            right.push(*r);
-        } else {
-            match split_clipped_bounds(&ctx.tris[r.id as usize], &r.bounds, s.axis, s.pos) {
-                (None, None) => left.push(*r),
-                (l, rr) => {
-                    left.extend(l.map(|bounds| Ref { bounds, id: r.id }));
-                    right.extend(rr.map(|bounds| Ref { bounds, id: r.id }));
-                }
-            }
-        }
-    }
-    if left.is_empty() || right.is_empty() {
-        return None;
-    }
-    let (le, re) = (Extent::of(&left), Extent::of(&right));
-    Some((left, le, right, re))
-}
-
-/// Equal slabs of a node's box along one axis: slab `b` spans `[plane(b), plane(b + 1)]`.
-#[derive(Clone, Copy)]
-struct Slabs {
-    axis: usize,
-    lo: f32,
-    width: f32,
-}
-
-impl Slabs {
-    /// The plane between slabs `b - 1` and `b`.
-    fn plane(&self, b: usize) -> f32 {
-        self.lo + self.width * b as f32
-    }
-
-    /// The slab holding coordinate `x` (the end slabs take what lies beyond them).
-    fn of(&self, x: f32) -> usize {
-        (((x - self.lo) / self.width) as usize).min(BINS - 1)
-    }
-
-    /// Grows `boxes[first..=last]` by the parts of triangle `tri` (within `bounds`) in those slabs: each
-    /// part's box is spanned by the corners in its slab and the edges' crossings of its two planes, each
-    /// plane's crossings found once for the slabs on both sides. Single precision and only for the spatial
-    /// bins' estimates; the references a split makes are clipped exactly ([`split_clipped_bounds`]).
-    fn chop(&self, tri: &[Vec3; 3], bounds: &Aabb, first: usize, last: usize, boxes: &mut [Aabb; BINS]) {
-        let mut parts = [Aabb::EMPTY; BINS];
-        for &v in tri {
-            let b = self.of(coord(&v, self.axis)).clamp(first, last);
-            parts[b] = parts[b].grow(v);
-        }
-        let edges: [(Vec3, Vec3, f32, f32); 3] = std::array::from_fn(|k| {
-            let (v, w) = (tri[k], tri[(k + 1) % 3]);
-            let (x, y) = (coord(&v, self.axis), coord(&w, self.axis));
-            (v, w - v, x, y)
-        });
-        for b in first + 1..=last {
-            let p = self.plane(b);
-            let mut cross = Aabb::EMPTY;
-            for &(v, d, x, y) in &edges {
-                if (x < p) != (y < p) {
-                    let mut c = v + d * ((p - x) / (y - x));
-                    *coord_mut(&mut c, self.axis) = p;
-                    cross = cross.grow(c);
-                }
-            }
-            parts[b - 1] = parts[b - 1].union(cross);
-            parts[b] = parts[b].union(cross);
-        }
-        for (slab_box, part) in boxes[first..=last].iter_mut().zip(&parts[first..=last]) {
-            let part = part.intersection(*bounds);
-            if !part.is_empty() {
-                *slab_box = slab_box.union(part);
-            }
-        }
-    }
-}
-
 /// SAH cost of a leaf of `n` triangles: its four-triangle blocks, as leaves are padded to whole blocks and a
 /// ray tests one block at a time, so one to four triangles cost the same.
-fn leaf_cost(n: usize) -> f32 {
+pub(super) fn leaf_cost(n: usize) -> f32 {
     n.div_ceil(4) as f32 * C_BLOCK
-}
-
-/// A spatial split: the plane `coord[axis] = pos`, with the references each side would get.
-struct SpatialSplit {
-    axis: usize,
-    pos: f32,
-    /// SAH cost in units of 4-box tests.
-    cost: f32,
-    left_n: usize,
-    right_n: usize,
-}
-
-/// One axis's spatial bins: each slab's box of reference parts, and how many references enter (start) and
-/// leave (end) in it.
-#[derive(Clone, Copy)]
-struct SpatialBins {
-    boxes: [Aabb; BINS],
-    enter: [usize; BINS],
-    leave: [usize; BINS],
-}
-
-impl SpatialBins {
-    const EMPTY: Self = Self { boxes: [Aabb::EMPTY; BINS], enter: [0; BINS], leave: [0; BINS] };
-
-    /// Adds reference `r` of triangle `tri`.
-    fn add(&mut self, slabs: &Slabs, tri: &[Vec3; 3], r: &Ref) {
-        let (first, last) = (slabs.of(coord(&r.bounds.min, slabs.axis)), slabs.of(coord(&r.bounds.max, slabs.axis)));
-        self.enter[first] += 1;
-        self.leave[last] += 1;
-        if first == last {
-            self.boxes[first] = self.boxes[first].union(r.bounds);
-        } else {
-            slabs.chop(tri, &r.bounds, first, last, &mut self.boxes);
-        }
-    }
-
-    /// The bins of both sets of references.
-    fn merge(mut self, o: &Self) -> Self {
-        for b in 0..BINS {
-            self.boxes[b] = self.boxes[b].union(o.boxes[b]);
-            self.enter[b] += o.enter[b];
-            self.leave[b] += o.leave[b];
-        }
-        self
-    }
-}
-
-/// The spatial bins of `refs` on each axis that has slabs; large nodes bin their references in parallel.
-fn bin_space(ctx: &Context, refs: &[Ref], slabs: &[Option<Slabs>; 3]) -> [SpatialBins; 3] {
-    let bin = |refs: &[Ref]| {
-        let mut bins = [SpatialBins::EMPTY; 3];
-        for (bins, slabs) in bins.iter_mut().zip(slabs) {
-            if let Some(slabs) = slabs {
-                for r in refs {
-                    bins.add(slabs, &ctx.tris[r.id as usize], r);
-                }
-            }
-        }
-        bins
-    };
-    if refs.len() < PARALLEL_MIN {
-        return bin(refs);
-    }
-    refs.par_chunks(PARALLEL_MIN / 2)
-        .map(bin)
-        .reduce(|| [SpatialBins::EMPTY; 3], |a, b| std::array::from_fn(|k| a[k].merge(&b[k])))
-}
-
-/// The cheapest plane between [`BINS`] equal slabs of `bounds` on any axis (Stich et al.'s spatial binning):
-/// each reference is cut into every slab it crosses ([`Slabs::chop`]), and counted where it enters and where it
-/// leaves.
-fn best_spatial(ctx: &Context, refs: &[Ref], bounds: &Aabb) -> Option<SpatialSplit> {
-    let total = bounds.surface_area().max(f32::MIN_POSITIVE);
-    let slabs: [Option<Slabs>; 3] = std::array::from_fn(|axis| {
-        let lo = coord(&bounds.min, axis);
-        let width = (coord(&bounds.max, axis) - lo) / BINS as f32;
-        (width > 0.0 && width.is_finite()).then_some(Slabs { axis, lo, width })
-    });
-    let bins = bin_space(ctx, refs, &slabs);
-    let mut best: Option<SpatialSplit> = None;
-    for (slabs, bins) in slabs.iter().zip(&bins) {
-        let Some(slabs) = slabs else { continue };
-        let mut right = [(Aabb::EMPTY, 0usize); BINS];
-        let (mut acc, mut n) = (Aabb::EMPTY, 0);
-        for b in (1..BINS).rev() {
-            (acc, n) = (acc.union(bins.boxes[b]), n + bins.leave[b]);
-            right[b] = (acc, n);
-        }
-        let (mut acc, mut n) = (Aabb::EMPTY, 0);
-        for b in 0..BINS - 1 {
-            (acc, n) = (acc.union(bins.boxes[b]), n + bins.enter[b]);
-            let (right_box, right_n) = right[b + 1];
-            if n == 0 || right_n == 0 {
-                continue;
-            }
-            let cost =
-                C_TRAV + (acc.surface_area() * leaf_cost(n) + right_box.surface_area() * leaf_cost(right_n)) / total;
-            if best.as_ref().is_none_or(|s| cost < s.cost) {
-                best = Some(SpatialSplit { axis: slabs.axis, pos: slabs.plane(b + 1), cost, left_n: n, right_n });
-            }
-        }
-    }
-    best
 }
 
 /// [`Aabb::surface_area`] of the box `[lo, hi]`, on 16-byte vectors (the same operations in the same order).

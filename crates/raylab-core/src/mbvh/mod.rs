@@ -5,6 +5,7 @@ mod build;
 mod node;
 mod refit;
 mod single;
+mod spatial;
 mod stream;
 
 pub use node::{EMPTY, MbvhNode};

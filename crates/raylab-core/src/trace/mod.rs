@@ -22,7 +22,7 @@ use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
 use crate::kdtree::packet::PacketStack;
 use crate::mbvh::{Mbvh, StreamLeaves, StreamOptions};
-use crate::method::Method;
+use crate::method::{Intersector, Method};
 use crate::packet::PacketTile;
 use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
@@ -268,23 +268,9 @@ impl<'a> Tracer<'a> {
     ) {
         assert!(rays.len() == width * height && out.len() == rays.len());
         match self.options.method {
-            Method::Mono => {
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = r.and_then(|r| self.tree.intersect(&r, stats));
-                }
-            }
-            Method::Reference => {
-                let bf = self.reference();
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = r.and_then(|r| bf.intersect(&r, stats));
-                }
-            }
-            Method::Mbvh => {
-                let m = self.mbvh();
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = r.and_then(|r| m.intersect(&r, stats));
-                }
-            }
+            Method::Mono => closest_each(self.tree, rays, out, stats),
+            Method::Reference => closest_each(self.reference(), rays, out, stats),
+            Method::Mbvh => closest_each(self.mbvh(), rays, out, stats),
             Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
                 self.mbvh().intersect_stream(r, o, self.stream_options(), stats)
             }),
@@ -308,23 +294,9 @@ impl<'a> Tracer<'a> {
     ) {
         assert!(rays.len() == width * height && out.len() == rays.len());
         match self.options.method {
-            Method::Mono => {
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = r.is_some_and(|r| self.tree.occluded(&r, stats));
-                }
-            }
-            Method::Reference => {
-                let bf = self.reference();
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = r.is_some_and(|r| bf.occluded(&r, stats));
-                }
-            }
-            Method::Mbvh => {
-                let m = self.mbvh();
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = r.is_some_and(|r| m.occluded(&r, stats));
-                }
-            }
+            Method::Mono => occluded_each(self.tree, rays, out, stats),
+            Method::Reference => occluded_each(self.reference(), rays, out, stats),
+            Method::Mbvh => occluded_each(self.mbvh(), rays, out, stats),
             Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
                 self.mbvh().occluded_stream(r, o, self.stream_options(), stats)
             }),
@@ -519,6 +491,20 @@ impl<'a> Tracer<'a> {
             let bits = b.bits();
             tile.for_each_lane(j, |pixel, lane| out[pixel] = bits >> lane & 1 == 1);
         }
+    }
+}
+
+/// Closest hits of `rays` one ray at a time, for the single-ray methods.
+fn closest_each<I: Intersector>(i: &I, rays: &[Option<Ray>], out: &mut [Option<Hit>], stats: &mut TraversalStats) {
+    for (o, r) in out.iter_mut().zip(rays) {
+        *o = r.and_then(|r| i.intersect(&r, stats));
+    }
+}
+
+/// Occlusion of `rays` one ray at a time, for the single-ray methods.
+fn occluded_each<I: Intersector>(i: &I, rays: &[Option<Ray>], out: &mut [bool], stats: &mut TraversalStats) {
+    for (o, r) in out.iter_mut().zip(rays) {
+        *o = r.is_some_and(|r| i.occluded(&r, stats));
     }
 }
 
