@@ -25,5 +25,6 @@ target/release/raylab-bench compare --embree target/embree-bench/embree_bench \
 
 # Replace the text between the markers in docs/BENCHMARKS.md with the fresh table.
 splice_section mono-vs-embree "$table"
+python3 scripts/targets.py
 rm -f "$table"
 echo "updated docs/BENCHMARKS.md"

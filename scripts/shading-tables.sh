@@ -20,5 +20,6 @@ target/release/raylab-bench tables --part shading --scene ../shared/scenes/sponz
   --images docs/images/shadows --markdown "$table"
 
 splice_section shading-tables "$table"
+python3 scripts/targets.py
 rm -f "$table"
 echo "updated docs/BENCHMARKS.md"

@@ -17,5 +17,6 @@ target/release/raylab-bench tables --part primary --scene ../shared/scenes/sponz
   --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0 --threads 2 --reps "$reps" --markdown "$table"
 
 splice_section thesis-tables "$table"
+python3 scripts/targets.py
 rm -f "$table"
 echo "updated docs/BENCHMARKS.md"

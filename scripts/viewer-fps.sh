@@ -77,5 +77,6 @@ echo >> "$table"
 echo "GPU: $(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['gpu'])" "$stats")." >> "$table"
 
 splice_section viewer-fps "$table"
+python3 scripts/targets.py
 rm -rf "$work"
 echo "updated docs/BENCHMARKS.md"
