@@ -14,7 +14,7 @@ use super::frustum::{BatchBits, ChunkSet, Leaf, front_child, hit_limit, leaf_int
 use super::mono::SPLIT_SLACK;
 use super::{KdParams, KdTree};
 use crate::aabb::coord;
-use crate::packet::{Bundle, PacketTile, bundle_lanes, map3};
+use crate::packet::{Bundle, PacketTile};
 use crate::stats::TraversalStats;
 
 /// The four-lane vectors of the frustum lanes when packets have `V`'s width.
@@ -43,18 +43,32 @@ impl<V: Vf32> Frustum4<V> {
         assert_eq!(Q::<V>::LANES, 4, "MFT traces four bundles");
         let origin = f.iter().flatten().next()?.origin();
         assert!(f.iter().flatten().all(|x| x.origin() == origin), "MFT bundles share their origin");
-        let lanes = |g: &dyn Fn(&B) -> f32, empty: f32| bundle_lanes::<Q<V>, _>(&f, g, empty);
-        let axes = |g: &dyn Fn(&B, usize) -> f32, empty: f32| map3([0, 1, 2], |k| lanes(&|x: &B| g(x, k), empty));
-        let valid = f.iter().enumerate().fold(0u32, |m, (i, x)| m | ((x.is_some() as u32) << i));
+        // Plain loops into arrays rather than closures per field, which may stay out of line (see `map3`):
+        // `axes[k][j]` holds factor `j` of axis `k` ([`Bundle::factors`]) for the four lanes.
+        let (inf, ninf) = (f32::INFINITY, f32::NEG_INFINITY);
+        let mut axes = [[[inf; 4], [inf; 4], [ninf; 4], [ninf; 4]]; 3];
+        let (mut t_min, mut t_max, mut origin_slack, mut valid) = ([inf; 4], [ninf; 4], 0.0f32, 0u32);
+        for (i, x) in f.iter().enumerate() {
+            if let Some(x) = x {
+                for (k, axis) in axes.iter_mut().enumerate() {
+                    let [pn, pf, nn, nf] = x.factors(k);
+                    (axis[0][i], axis[1][i], axis[2][i], axis[3][i]) = (pn, pf, nn, nf);
+                }
+                (t_min[i], t_max[i]) = x.t_range();
+                origin_slack = origin_slack.max(x.origin_slack());
+                valid |= 1 << i;
+            }
+        }
+        let [x, y, z] = &axes;
         Some(Self {
             origin,
-            pos_near: axes(&|x, k| x.factors(k)[0], f32::INFINITY),
-            pos_far: axes(&|x, k| x.factors(k)[1], f32::INFINITY),
-            neg_near: axes(&|x, k| x.factors(k)[2], f32::NEG_INFINITY),
-            neg_far: axes(&|x, k| x.factors(k)[3], f32::NEG_INFINITY),
-            t_min: lanes(&|x| x.t_range().0, f32::INFINITY),
-            t_max: lanes(&|x| x.t_range().1, f32::NEG_INFINITY),
-            origin_slack: f.iter().flatten().fold(0.0f32, |m, x| m.max(x.origin_slack())),
+            pos_near: [Q::<V>::from_slice(&x[0]), Q::<V>::from_slice(&y[0]), Q::<V>::from_slice(&z[0])],
+            pos_far: [Q::<V>::from_slice(&x[1]), Q::<V>::from_slice(&y[1]), Q::<V>::from_slice(&z[1])],
+            neg_near: [Q::<V>::from_slice(&x[2]), Q::<V>::from_slice(&y[2]), Q::<V>::from_slice(&z[2])],
+            neg_far: [Q::<V>::from_slice(&x[3]), Q::<V>::from_slice(&y[3]), Q::<V>::from_slice(&z[3])],
+            t_min: Q::<V>::from_slice(&t_min),
+            t_max: Q::<V>::from_slice(&t_max),
+            origin_slack,
             valid: <Q<V> as Vf32>::Mask::from_bits(valid),
         })
     }

@@ -158,8 +158,10 @@ impl<V: Vf32> RayPacket<V> {
     /// The ray in lane `i`.
     #[inline(always)]
     pub fn ray(&self, i: usize) -> Ray {
-        let c = |v: &[V; 3]| Vec3::new(v[0].lane(i), v[1].lane(i), v[2].lane(i));
-        Ray::segment(c(&self.org), c(&self.dir), self.tmin.lane(i), self.tmax.lane(i))
+        // Written out rather than with a closure per vector, which may stay out of line (see `map3`).
+        let (o, d) = (&self.org, &self.dir);
+        let origin = Vec3::new(o[0].lane(i), o[1].lane(i), o[2].lane(i));
+        Ray::segment(origin, Vec3::new(d[0].lane(i), d[1].lane(i), d[2].lane(i)), self.tmin.lane(i), self.tmax.lane(i))
     }
 }
 
@@ -169,17 +171,6 @@ impl<V: Vf32> RayPacket<V> {
 #[inline(always)]
 pub(crate) fn map3<T: Copy, U>(a: [T; 3], f: impl Fn(T) -> U) -> [U; 3] {
     [f(a[0]), f(a[1]), f(a[2])]
-}
-
-/// One field of up to four bundles (MFT's frustums or cones) in the first four lanes, `empty` in the others
-/// and where a bundle is missing.
-#[inline(always)]
-pub(crate) fn bundle_lanes<V: Vf32, B>(bundles: &[Option<B>; 4], field: &dyn Fn(&B) -> f32, empty: f32) -> V {
-    let mut a = V::array_from_fn(|_| empty);
-    for (lane, b) in a.as_mut().iter_mut().zip(bundles) {
-        *lane = b.as_ref().map_or(empty, field);
-    }
-    V::from_slice(a.as_ref())
 }
 
 /// Closest hits of a packet, per lane.

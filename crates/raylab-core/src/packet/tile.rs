@@ -4,7 +4,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{BatchCull, Disc, PacketHits, RayPacket, map3};
+use super::{BatchCull, Disc, PacketHits, RayPacket};
 use crate::aabb::{Aabb, coord};
 use crate::ray::Ray;
 
@@ -15,9 +15,13 @@ pub const fn packet_shape(lanes: usize) -> (usize, usize) {
     (w, lanes / w)
 }
 
-/// The packets of a `width x height` tile in row-major pixel order, each [`Self::PACKET_W`] (`w`) pixels wide
-/// and [`Self::PACKET_H`] (`h`) high; lane `i` holds pixel `(w bx + i % w, h by + i / w)`. Pixels outside the
-/// tile leave lanes empty.
+/// The packets of a `width x height` tile, each [`Self::PACKET_W`] (`w`) pixels wide and [`Self::PACKET_H`]
+/// (`h`) high; lane `i` holds pixel `(w bx + i % w, h by + i / w)`. Pixels outside the tile leave lanes empty.
+///
+/// Packets are stored quadrant by quadrant (top left, top right, bottom left, bottom right; the quadrants of
+/// MFT, 4.1.5, split at [`Self::quadrant_split`]), row-major inside each, so a quadrant's packets are one run
+/// of indices: its packets fill whole chunks of [`Vf32::LANES`] ([`crate::packet::BatchCull`]) when its
+/// packet count is a multiple of the lanes, and each chunk of a tile is a compact block of pixels.
 pub struct PacketTile<V: Vf32> {
     /// The packets.
     pub packets: Vec<RayPacket<V>>,
@@ -89,21 +93,29 @@ impl<V: Vf32> PacketTile<V> {
         packets.reserve(n);
         origin_pixel.reserve(n);
         hits.reserve(n);
-        for by in 0..rows {
-            // The next row of packets' rays start loading while this row is packed: a tile's rays (36 KiB at
-            // 32x32) come from memory when a whole frame's rays were made before tracing, and packing waited
-            // on them (7-8% of a primary MFT 32x32 trace in `perf`, 4-5% with the hint).
-            let next = rays.len().min((by + 1) * ph * width)..rays.len().min((by + 2) * ph * width);
-            raylab_simd::prefetch(&rays[next]);
-            for bx in 0..cols {
-                let p = RayPacket::gather(|i| {
-                    let (x, y) = (pw * bx + i % pw, ph * by + i / pw);
-                    if x < width && y < height { rays[y * width + x] } else { None }
-                });
-                hits.push(PacketHits::new(&p));
-                farthest_hit.push(V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max());
-                packets.push(p);
-                origin_pixel.push((pw * bx, ph * by));
+        let (sx, sy) = quadrant_split(cols, rows);
+        for (xs, ys) in [(0..sx, 0..sy), (sx..cols, 0..sy), (0..sx, sy..rows), (sx..cols, sy..rows)] {
+            let (x0, x1) = (pw * xs.start, width.min(pw * xs.end));
+            for by in ys.clone() {
+                // The next row of packets' rays start loading while this row is packed: a tile's rays (36 KiB
+                // at 32x32) come from memory when a whole frame's rays were made before tracing, and packing
+                // waited on them (7-8% of a primary MFT 32x32 trace in `perf`, 4-5% with the hint).
+                let next = if by + 1 < ys.end { ph * (by + 1)..ph * (by + 2) } else { 0..0 };
+                for y in next {
+                    if let Some(row) = rays.get(y * width + x0..y * width + x1) {
+                        raylab_simd::prefetch(row);
+                    }
+                }
+                for bx in xs.clone() {
+                    let p = RayPacket::gather(|i| {
+                        let (x, y) = (pw * bx + i % pw, ph * by + i / pw);
+                        if x < width && y < height { rays[y * width + x] } else { None }
+                    });
+                    hits.push(PacketHits::new(&p));
+                    farthest_hit.push(V::select(p.valid, p.tmax, V::splat(f32::NEG_INFINITY)).reduce_max());
+                    packets.push(p);
+                    origin_pixel.push((pw * bx, ph * by));
+                }
             }
         }
         farthest_hit.resize(n.div_ceil(V::LANES) * V::LANES, f32::NEG_INFINITY);
@@ -127,7 +139,24 @@ impl<V: Vf32> PacketTile<V> {
         }
     }
 
-    /// Indices of the packets inside the pixel rectangle `[x0, x1) x [y0, y1)` (packet-aligned).
+    /// The first packet column and row of the right and bottom quadrants ([`quadrant_split`]).
+    #[inline(always)]
+    pub fn quadrant_split(&self) -> (usize, usize) {
+        quadrant_split(self.cols, self.rows)
+    }
+
+    /// Index of the packet in column `bx` and row `by` (the storage order of [`PacketTile`]).
+    #[inline(always)]
+    pub fn packet_index(&self, bx: usize, by: usize) -> usize {
+        let (sx, sy) = self.quadrant_split();
+        let (right, below) = (bx >= sx, by >= sy);
+        let (qw, x0) = if right { (self.cols - sx, sx) } else { (sx, 0) };
+        let (top, y0) = if below { (sy, sy) } else { (0, 0) };
+        let before = top * self.cols + if right { (if below { self.rows - sy } else { sy }) * sx } else { 0 };
+        before + (by - y0) * qw + bx - x0
+    }
+
+    /// Indices of the packets inside the pixel rectangle `[x0, x1) x [y0, y1)` (packet-aligned), ascending.
     #[inline(always)]
     pub fn packets_in(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> Vec<usize> {
         let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
@@ -135,11 +164,19 @@ impl<V: Vf32> PacketTile<V> {
         let mut v = Vec::with_capacity(ys.len() * xs.len());
         for by in ys {
             for bx in xs.clone() {
-                v.push(by * self.cols + bx);
+                v.push(self.packet_index(bx, by));
             }
         }
+        v.sort_unstable();
         v
     }
+}
+
+/// The first packet column and row of the right and bottom quadrants of a tile of `cols x rows` packets: the
+/// left and top quadrants take the larger half.
+#[inline(always)]
+const fn quadrant_split(cols: usize, rows: usize) -> (usize, usize) {
+    (cols.div_ceil(2), rows.div_ceil(2))
 }
 
 /// Per lane, the interval `[t0, t1]` in which the packet's ray is inside box `b`, clipped to `[tmin, tmax]`
@@ -356,10 +393,12 @@ impl Frustum {
         }
         let mut f = Frustum {
             origin,
-            pos_near: map3(pos_near, V::reduce_min),
-            pos_far: map3(pos_far, V::reduce_max),
-            neg_near: map3(neg_near, V::reduce_max),
-            neg_far: map3(neg_far, V::reduce_min),
+            // Written out: `map3` with `V::reduce_min` as a function item may call a shim that is neither inlined
+            // nor compiled for the kernel's instruction set (seen in callgrind as `Fn::call` around `vcmpps`).
+            pos_near: [pos_near[0].reduce_min(), pos_near[1].reduce_min(), pos_near[2].reduce_min()],
+            pos_far: [pos_far[0].reduce_max(), pos_far[1].reduce_max(), pos_far[2].reduce_max()],
+            neg_near: [neg_near[0].reduce_max(), neg_near[1].reduce_max(), neg_near[2].reduce_max()],
+            neg_far: [neg_far[0].reduce_min(), neg_far[1].reduce_min(), neg_far[2].reduce_min()],
             t_min: t_min.reduce_min().max(0.0),
             t_max: t_max.reduce_max(),
             origin_slack: 0.0,
@@ -433,6 +472,45 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// Every packet sits at the index [`PacketTile::packet_index`] gives for its column and row, and each
+    /// quadrant's packets are one run of indices, whole chunks in even tiles.
+    struct QuadrantOrder;
+
+    impl raylab_simd::Kernel for QuadrantOrder {
+        type Output = ();
+        fn run<V: Vf32>(self) {
+            let (pw, ph) = (PacketTile::<V>::PACKET_W, PacketTile::<V>::PACKET_H);
+            for (w, h) in [(16, 16), (32, 32), (8, 8), (5, 3), (9, 6), (40, 24), (1, 1), (20, 7)] {
+                let t = PacketTile::<V>::new(&tile_rays(w, h, 0.5), w, h);
+                assert_eq!(t.packets.len(), t.cols * t.rows, "{w}x{h}");
+                for by in 0..t.rows {
+                    for bx in 0..t.cols {
+                        assert_eq!(t.origin_pixel[t.packet_index(bx, by)], (pw * bx, ph * by), "{w}x{h} ({bx}, {by})");
+                    }
+                }
+                let (sx, sy) = t.quadrant_split();
+                let (cx, cy) = (sx * pw, sy * ph);
+                let mut next = 0;
+                for (x0, y0, x1, y1) in [(0, 0, cx, cy), (cx, 0, w, cy), (0, cy, cx, h), (cx, cy, w, h)] {
+                    let set = if x0 < x1 && y0 < y1 { t.packets_in(x0, y0, x1, y1) } else { Vec::new() };
+                    assert_eq!(set, (next..next + set.len()).collect::<Vec<_>>(), "{w}x{h} quadrant at ({x0}, {y0})");
+                    next += set.len();
+                    if t.cols.is_multiple_of(2) && t.rows.is_multiple_of(2) && (sx * sy).is_multiple_of(V::LANES) {
+                        assert_eq!(set[0] % V::LANES, 0, "{w}x{h}: quadrants of whole chunks");
+                    }
+                }
+                assert_eq!(next, t.packets.len(), "{w}x{h}: the quadrants cover the tile");
+            }
+        }
+    }
+
+    #[test]
+    fn packets_are_stored_quadrant_by_quadrant_on_every_backend() {
+        for backend in raylab_simd::Backend::available() {
+            raylab_simd::dispatch(backend, QuadrantOrder);
         }
     }
 

@@ -49,7 +49,8 @@ impl Tracer<'_> {
         toward_fn: fn(&Bundled<V>, Vec3, f32) -> Option<B>,
     ) -> Option<Quadrants<B>> {
         let (pw, ph) = (PacketTile::<V>::PACKET_W, PacketTile::<V>::PACKET_H);
-        let (cx, cy) = (tile.cols.div_ceil(2) * pw, tile.rows.div_ceil(2) * ph);
+        let (cx, cy) = tile.quadrant_split();
+        let (cx, cy) = (cx * pw, cy * ph);
         let (w, h) = (tile.width, tile.height);
         let quads = [(0, 0, cx.min(w), cy.min(h)), (cx, 0, w, cy.min(h)), (0, cy, cx.min(w), h), (cx, cy, w, h)];
         let mut sets: [Vec<usize>; 4] = Default::default();

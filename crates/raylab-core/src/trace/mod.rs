@@ -240,13 +240,14 @@ impl<'a> Tracer<'a> {
             let (tile, grid) = (&*tile, &grid[..]);
             let whole = Bundled { tile, set: all, rays: RayRect { rays: grid, width: pw, x: 0..pw, y: 0..height } };
             let (limit, cull) = (self.options.shadow_spread_limit, self.options.cull);
-            let walked = match method {
-                Method::Cone | Method::MftCone => toward_cone(&whole, toward, limit)
-                    .map(|c| self.tree.edge_widths_bundle(&c, tile, cull, states, out, stats)),
-                _ => toward_frustum(&whole, toward, limit)
-                    .map(|f| self.tree.edge_widths_bundle(&f, tile, cull, states, out, stats)),
-            };
-            if walked.is_some() {
+            // `if let` rather than `Option::map` closures, whose vector code may stay out of line (see `map3`).
+            if matches!(method, Method::Cone | Method::MftCone) {
+                if let Some(c) = toward_cone(&whole, toward, limit) {
+                    self.tree.edge_widths_bundle(&c, tile, cull, states, out, stats);
+                    return;
+                }
+            } else if let Some(f) = toward_frustum(&whole, toward, limit) {
+                self.tree.edge_widths_bundle(&f, tile, cull, states, out, stats);
                 return;
             }
         }
@@ -383,20 +384,24 @@ impl<'a> Tracer<'a> {
                 c.is_some()
             }
             Method::Mft => {
-                let quads = self.quadrants(tile, rays, None, common_origin_frustum, toward_frustum);
-                let f4 = quads.and_then(|(b, sets, _)| Some((Frustum4::new(b)?, sets)));
-                if let Some((f4, sets)) = &f4 {
-                    self.tree.intersect_mft(f4, tile, sets, cull, stats);
+                if let Some((b, sets, _)) = self.quadrants(tile, rays, None, common_origin_frustum, toward_frustum)
+                    && let Some(f4) = Frustum4::new(b)
+                {
+                    self.tree.intersect_mft(&f4, tile, &sets, cull, stats);
+                    true
+                } else {
+                    false
                 }
-                f4.is_some()
             }
             Method::MftCone => {
-                let quads = self.quadrants(tile, rays, None, common_origin_cone, toward_cone);
-                let c4 = quads.and_then(|(b, sets, _)| Some((Frustum4::new(b)?, sets)));
-                if let Some((c4, sets)) = &c4 {
-                    self.tree.intersect_mft(c4, tile, sets, cull, stats);
+                if let Some((b, sets, _)) = self.quadrants(tile, rays, None, common_origin_cone, toward_cone)
+                    && let Some(c4) = Frustum4::new(b)
+                {
+                    self.tree.intersect_mft(&c4, tile, &sets, cull, stats);
+                    true
+                } else {
+                    false
                 }
-                c4.is_some()
             }
             _ => false,
         };
