@@ -3,14 +3,15 @@
 # single-ray table of docs/BENCHMARKS.md with `raylab-bench compare`, which runs Embree and raylab on the same
 # OBJ, view, light and rays in one invocation. Run it on a committed tree: the table records the commit.
 #
-#   scripts/bench-vs-embree.sh            # 512x512, threads 1 and 2, 7 timed runs each
-#   REPS=3 scripts/bench-vs-embree.sh
+#   scripts/bench-vs-embree.sh            # 512x512, threads 1 and 2, 3 rounds of 5 timed runs each
+#   REPS=3 ROUNDS=5 scripts/bench-vs-embree.sh
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 # shellcheck source=lib/splice.sh
 source "$root/scripts/lib/splice.sh"
 shared=${SHARED:-$root/../shared}
-reps=${REPS:-7}
+reps=${REPS:-5}
+rounds=${ROUNDS:-3}
 harness=$root/target/embree-bench
 mkdir -p "$harness"
 cp "$shared/tools/embree-bench/embree_bench.cpp" "$shared/tools/embree-bench/Makefile" "$harness/"
@@ -21,7 +22,7 @@ cd "$root"
 table=$(mktemp)
 target/release/raylab-bench compare --embree target/embree-bench/embree_bench \
   --scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 --target 10,5.5,0 --up 0,1,0 --fov 65 \
-  --light 0,11,0 --width 512 --height 512 --threads 1,2 --reps "$reps" --warmup 1 --builds 3 --markdown "$table"
+  --light 0,11,0 --width 512 --height 512 --threads 1,2 --reps "$reps" --rounds "$rounds" --warmup 1 --builds 3 --markdown "$table"
 
 # Replace the text between the markers in docs/BENCHMARKS.md with the fresh table.
 splice_section mono-vs-embree "$table"

@@ -468,3 +468,75 @@ fn compare_takes_turns_with_the_harness_and_reports_its_figures() {
     // Each invocation repeats the primary check; the table lists it once.
     assert_eq!(md.matches("256 primary rays").count(), 1, "{md}");
 }
+
+/// A harness whose primary single-ray figures change from one invocation to the next: medians 1.0, 3.0, then
+/// 2.0 Mrays/s, each with a spread of 0.1.
+#[cfg(unix)]
+const FAKE_DRIFTING_HARNESS: &str = r###"#!/bin/sh
+kinds=all
+while [ $# -gt 0 ]; do
+  if [ "$1" = "--kinds" ]; then kinds="$2"; fi
+  shift
+done
+echo "$kinds" >> "$0.log"
+n=$(grep -c primary "$0.log")
+echo "build HIGH       1 thread(s): median 0.123 s (min 0.100, max 0.200, 1 builds)"
+case "$kinds" in
+  primary) case "$n" in
+             1) echo "CSV,16x16,primary_1,1,256,1.000,0.900,1.100,0.000,1" ;;
+             2) echo "CSV,16x16,primary_1,1,256,3.000,2.900,3.100,0.000,1" ;;
+             *) echo "CSV,16x16,primary_1,1,256,2.000,1.900,2.100,0.000,1" ;;
+           esac ;;
+  shadow) echo "CSV,16x16,shadow_1,1,200,2.500,2.400,2.600,0.000,1" ;;
+  diffuse) echo "CSV,16x16,diffuse_1,1,200,0.750,0.700,0.800,0.000,1" ;;
+esac
+"###;
+
+#[cfg(unix)]
+#[test]
+fn compare_rounds_repeat_the_turns_and_report_the_median_round() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let harness = dir.path().join("embree_bench");
+    std::fs::write(&harness, FAKE_DRIFTING_HARNESS).unwrap();
+    std::fs::set_permissions(&harness, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let args = [
+        "compare",
+        "--embree",
+        harness.to_str().unwrap(),
+        "--scene",
+        "arena",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--threads",
+        "1",
+        "--reps",
+        "1",
+        "--builds",
+        "1",
+        "--methods",
+        "frustum",
+        "--tiles",
+        "8",
+        "--incoherent",
+        "mbvh",
+        "--rounds",
+        "3",
+    ];
+    let o = bench(&args, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let log = std::fs::read_to_string(dir.path().join("embree_bench.log")).unwrap();
+    assert_eq!(log, format!("none\n{}", "primary\nshadow\ndiffuse\n".repeat(3)));
+    let md = String::from_utf8_lossy(&o.stdout);
+    let rows = |start: &str| md.lines().filter(|l| l.starts_with(start)).collect::<Vec<_>>();
+    // The median of the rounds' medians, between the lowest minimum and the highest maximum of all rounds.
+    let primary = rows("| primary | 1 | ");
+    let mono: Vec<_> = primary.iter().filter(|l| l.contains("rtcIntersect1")).collect();
+    assert_eq!(mono.len(), 1, "{md}");
+    assert!(mono[0].contains("| rtcIntersect1 | 2.00 (0.90-3.10) |"), "{md}");
+    // One row per configuration, however many rounds.
+    assert_eq!(rows("| primary | 1 | frustum | 8 |").len(), 1, "{md}");
+    assert_eq!(rows("| mbvh | 1 |").len(), 1, "{md}");
+}

@@ -1,7 +1,9 @@
 //! `raylab-bench compare`: the Embree harness and raylab on the same OBJ, view, light and rays in one
 //! invocation, printed as one markdown table for `docs/BENCHMARKS.md`. The two take turns: the harness builds
 //! next to raylab's builds, and runs each ray kind just before raylab's runs of that kind, so that a host whose
-//! speed drifts over the minutes of a run (a shared machine) skews the ratios as little as it can.
+//! speed drifts over the minutes of a run (a shared machine) skews the ratios as little as it can; `--rounds`
+//! repeats that sequence and reports the median round, so that a slow spell of the host lands on one round of
+//! a configuration rather than on all of its runs.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -43,6 +45,12 @@ pub struct CompareArgs {
     /// Untimed runs before timing.
     #[arg(long, default_value_t = 1, value_parser = in_range(0, 10_000))]
     warmup: u64,
+    /// Rounds: the whole sequence of ray kinds (harness, then raylab's configurations) runs this many times,
+    /// `--reps` timed runs per configuration each round, and each table cell reports the median of the rounds'
+    /// medians (with the slowest and fastest run of all rounds). Spread over the invocation like this, every
+    /// configuration meets a shared host's slow spells about as often as the others.
+    #[arg(long, default_value_t = 1, value_parser = in_range(1, 100))]
+    rounds: u64,
     /// Acceleration-structure builds per thread count (the median is reported).
     #[arg(long, default_value_t = 3, value_parser = in_range(1, 100))]
     builds: u64,
@@ -65,6 +73,7 @@ pub struct CompareArgs {
 }
 
 /// Embree's numbers for one kind and thread count.
+#[derive(Clone)]
 struct EmbreeRow {
     kind: String,
     threads: u64,
@@ -83,16 +92,53 @@ struct EmbreeRun {
 
 impl EmbreeRun {
     /// Adds one invocation's builds and rows, and its checks not seen before (each invocation repeats the
-    /// primary check).
-    fn merge(&mut self, run: EmbreeRun) {
+    /// primary check). A row for a kind and thread count seen in an earlier round joins that row's rounds.
+    fn merge(&mut self, run: EmbreeRun, rounds: &mut Vec<Vec<EmbreeRow>>) {
         self.builds.extend(run.builds);
-        self.rows.extend(run.rows);
+        for row in run.rows {
+            match self.rows.iter().position(|e| e.kind == row.kind && e.threads == row.threads) {
+                Some(i) => rounds[i].push(row),
+                None => {
+                    rounds.push(vec![row.clone()]);
+                    self.rows.push(row);
+                }
+            }
+        }
         for check in run.checks {
             if !self.checks.contains(&check) {
                 self.checks.push(check);
             }
         }
     }
+
+    /// Replaces each row's figures by those of its rounds ([`median_of_rounds`]).
+    fn combine(&mut self, rounds: &[Vec<EmbreeRow>]) {
+        for (row, all) in self.rows.iter_mut().zip(rounds) {
+            let (median, min, max) = median_of_rounds(all.iter().map(|e| (e.median, e.min, e.max)));
+            (row.median, row.min, row.max) = (median, min, max);
+        }
+    }
+}
+
+/// Over rounds of `(median, min, max)`: the median of the medians (the lower middle one for an even count), the
+/// smallest minimum and the largest maximum.
+fn median_of_rounds(rounds: impl Iterator<Item = (f64, f64, f64)>) -> (f64, f64, f64) {
+    let (mut medians, mut min, mut max) = (Vec::new(), f64::INFINITY, f64::NEG_INFINITY);
+    for (median, lo, hi) in rounds {
+        medians.push(median);
+        (min, max) = (min.min(lo), max.max(hi));
+    }
+    medians.sort_by(f64::total_cmp);
+    (medians.get(medians.len().saturating_sub(1) / 2).copied().unwrap_or(f64::NAN), min, max)
+}
+
+/// The first round's report of a configuration, with its Mrays/s figures taken over all rounds
+/// ([`median_of_rounds`]); the counters and checksums are the same in every round.
+fn combine_reports(rounds: &[&TraceReport]) -> TraceReport {
+    let mut r = rounds[0].clone();
+    (r.mrays_median, r.mrays_min, r.mrays_max) =
+        median_of_rounds(rounds.iter().map(|x| (x.mrays_median, x.mrays_min, x.mrays_max)));
+    r
 }
 
 /// A report's checksum column: the occluded count, or the hits and their distances' sum.
@@ -162,7 +208,9 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let (scene, _) = load_scene(&a.scene.source())?;
     let (cam, light) = a.scene.camera_and_light(&scene)?;
     let mut embree = EmbreeRun::default();
-    embree.merge(with_spinner("Embree harness: builds", || run_embree(a, &cam, light.position, "none", a.builds))?);
+    let mut embree_rounds = Vec::new();
+    let builds_run = with_spinner("Embree harness: builds", || run_embree(a, &cam, light.position, "none", a.builds))?;
+    embree.merge(builds_run, &mut embree_rounds);
 
     // The thesis's tree for single rays, and the one with the packet methods' cost model
     // (`KdParams::for_method`) for packets, frustums, MFT and cones.
@@ -188,53 +236,51 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let reference = BruteForce::new(&scene);
     let (w, h) = a.image.size();
     let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree));
-    // Per ray kind: the harness first, then raylab's single rays, then the coherent methods (primary and
-    // shadow rays) or the incoherent ones (diffuse rays).
-    let mut ours: Vec<TraceReport> = Vec::new();
-    let mut coherent: Vec<(Method, u64, TraceReport)> = Vec::new();
-    let mut mbvh_builds = Vec::new();
-    let mut dacrt_setup = None;
-    let mut incoherent: Vec<(String, TraceReport)> = Vec::new();
-    for kind in RayKind::ALL {
-        let label = format!("Embree harness: {kind} rays");
-        embree.merge(with_spinner(&label, || run_embree(a, &cam, light.position, kind.name(), 1))?);
-        let workload = wb.build(kind);
-        for &t in &a.threads {
-            let tracer = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
-            let (report, results) =
-                measure(&tracer, &workload, HARNESS_TILE, (t as usize, a.warmup as usize, a.reps as usize), None)?;
-            validate(&reference, &workload, &results, 256).map_err(|m| format!("validation failed: {m}"))?;
-            ours.push(report);
-        }
-        if kind == RayKind::Diffuse {
-            // Incoherent rays: the MBVH methods (MBVH RS paper) and DACRT (seed 003).
-            if !a.incoherent.is_empty() {
-                let (mbvh_times, setup, rows) = incoherent_runs(a, &scene, &tree, &reference, &workload)?;
-                (mbvh_builds, dacrt_setup, incoherent) = (mbvh_times, setup, rows);
+    // Per round and ray kind: the harness first, then raylab's single rays, then the coherent methods (primary
+    // and shadow rays) or the incoherent ones (diffuse rays).
+    let mut rounds = Vec::new();
+    let (mut mbvh_builds, mut dacrt_setup) = (Vec::new(), None);
+    for round in 1..=a.rounds {
+        let mut this = Round::default();
+        for kind in RayKind::ALL {
+            let label = format!("Embree harness: {kind} rays (round {round} of {})", a.rounds);
+            let run = with_spinner(&label, || run_embree(a, &cam, light.position, kind.name(), 1))?;
+            embree.merge(run, &mut embree_rounds);
+            let workload = wb.build(kind);
+            for &t in &a.threads {
+                let tracer = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
+                let runs = (t as usize, a.warmup as usize, a.reps as usize);
+                let (report, results) = measure(&tracer, &workload, HARNESS_TILE, runs, None)?;
+                validate(&reference, &workload, &results, 256).map_err(|m| format!("validation failed: {m}"))?;
+                this.ours.push(report);
             }
-            continue;
-        }
-        // Coherent methods: every tile size for the frustum methods.
-        for &method in a.methods.iter().filter(|m| m.uses_packets()) {
-            let tiles: Vec<u64> = if method.uses_tiles() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
-            for &tile in &tiles {
-                for &t in &a.threads {
-                    let walked = if method.uses_packets() { &packet_tree } else { &tree };
-                    let tracer = Tracer::new(walked, None, TraceOptions { method, ..Default::default() });
-                    let (report, results) = measure(
-                        &tracer,
-                        &workload,
-                        tile as u32,
-                        (t as usize, a.warmup as usize, a.reps as usize),
-                        None,
-                    )?;
-                    validate(&reference, &workload, &results, 256)
-                        .map_err(|m| format!("validation failed ({method} tile {tile}): {m}"))?;
-                    coherent.push((method, tile, report));
+            if kind == RayKind::Diffuse {
+                // Incoherent rays: the MBVH methods (MBVH RS paper) and DACRT (seed 003).
+                if !a.incoherent.is_empty() {
+                    let (mbvh_times, setup, rows) = incoherent_runs(a, &scene, &tree, &reference, &workload)?;
+                    (mbvh_builds, dacrt_setup, this.incoherent) = (mbvh_times, setup, rows);
+                }
+                continue;
+            }
+            // Coherent methods: every tile size for the frustum methods.
+            for &method in a.methods.iter().filter(|m| m.uses_packets()) {
+                let tiles: Vec<u64> = if method.uses_tiles() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
+                for &tile in &tiles {
+                    for &t in &a.threads {
+                        let tracer = Tracer::new(&packet_tree, None, TraceOptions { method, ..Default::default() });
+                        let runs = (t as usize, a.warmup as usize, a.reps as usize);
+                        let (report, results) = measure(&tracer, &workload, tile as u32, runs, None)?;
+                        validate(&reference, &workload, &results, 256)
+                            .map_err(|m| format!("validation failed ({method} tile {tile}): {m}"))?;
+                        this.coherent.push((method, tile, report));
+                    }
                 }
             }
         }
+        rounds.push(this);
     }
+    embree.combine(&embree_rounds);
+    let Round { ours, coherent, incoherent } = Round::combine(&rounds);
 
     let mut md = String::new();
     let cmd: Vec<String> = std::env::args().collect();
@@ -383,6 +429,37 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
     }
     Ok(())
+}
+
+/// raylab's reports of one round, in the order the configurations ran.
+#[derive(Default)]
+struct Round {
+    /// Single rays (`mono`), per ray kind and thread count.
+    ours: Vec<TraceReport>,
+    /// The coherent methods, per method, tile and thread count.
+    coherent: Vec<(Method, u64, TraceReport)>,
+    /// The incoherent methods, labelled as in [`Incoherent`].
+    incoherent: Vec<(String, TraceReport)>,
+}
+
+impl Round {
+    /// One round whose reports take their Mrays/s over all `rounds` ([`combine_reports`]), which ran the same
+    /// configurations in the same order.
+    fn combine(rounds: &[Round]) -> Round {
+        let pick = |i: usize, get: &dyn Fn(&Round, usize) -> &TraceReport| {
+            combine_reports(&rounds.iter().map(|r| get(r, i)).collect::<Vec<_>>())
+        };
+        let first = &rounds[0];
+        Round {
+            ours: (0..first.ours.len()).map(|i| pick(i, &|r, i| &r.ours[i])).collect(),
+            coherent: (0..first.coherent.len())
+                .map(|i| (first.coherent[i].0, first.coherent[i].1, pick(i, &|r, i| &r.coherent[i].2)))
+                .collect(),
+            incoherent: (0..first.incoherent.len())
+                .map(|i| (first.incoherent[i].0.clone(), pick(i, &|r, i| &r.incoherent[i].1)))
+                .collect(),
+        }
+    }
 }
 
 /// What the incoherent runs give: the MBVH's median build time per thread count, DACRT's setup time, and each
