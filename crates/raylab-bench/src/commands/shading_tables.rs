@@ -56,8 +56,8 @@ impl ShadingRun<'_> {
 
     /// Primary-ray frames (no reflections) under each of `techniques`, measured round by round.
     fn timed_together(&self, s: &Subject, tracer: &Tracer, light: PointLight, techniques: &[Shadows]) -> Vec<Cell> {
-        let configs: Vec<_> = techniques.iter().map(|&t| self.settings(t, 0, self.size)).collect();
-        measure_interleaved(s.scene, tracer, &s.camera, light, &configs, self.pool, self.reps)
+        let configs: Vec<_> = techniques.iter().map(|&t| (tracer, self.settings(t, 0, self.size))).collect();
+        measure_interleaved(s.scene, &s.camera, light, &configs, self.pool, self.reps)
     }
 
     /// Writes Tables 5.1, 4.6 and 3.1 and the image-quality table for `subjects` into `md`.

@@ -103,29 +103,29 @@ pub fn measure(
     pool: &rayon::ThreadPool,
     reps: u64,
 ) -> Cell {
-    measure_interleaved(scene, tracer, cam, light, std::slice::from_ref(s), pool, reps)[0]
+    measure_interleaved(scene, cam, light, &[(tracer, *s)], pool, reps)[0]
 }
 
-/// Measures several configurations of one view together: a warm-up frame of each, then `reps` rounds that
-/// render each once, so that a slow spell of a shared machine slows every configuration alike and the ratios
-/// between them (Table 5.1's edge/hard time, Table 4.6's cone speed-up) stay honest.
+/// Measures several configurations of one view together, each a tracer (a method) and frame settings: a
+/// warm-up frame of each, then `reps` rounds that render each once, so that a slow spell of a shared machine
+/// slows every configuration alike and the ratios between them (MFT against the frustum or the packets in
+/// Tables 4.1-4.4, Table 5.1's edge/hard time, Table 4.6's cone speed-up) stay honest.
 pub fn measure_interleaved(
     scene: &Scene,
-    tracer: &Tracer,
     cam: &Camera,
     light: PointLight,
-    configs: &[RenderSettings],
+    configs: &[(&Tracer, RenderSettings)],
     pool: &rayon::ThreadPool,
     reps: u64,
 ) -> Vec<Cell> {
     let mut times = vec![Vec::new(); configs.len()];
     let mut last = vec![None; configs.len()];
     pool.install(|| {
-        for s in configs {
+        for (tracer, s) in configs {
             render(scene, tracer, cam, light, s);
         }
         for _ in 0..reps {
-            for ((s, t), l) in configs.iter().zip(&mut times).zip(&mut last) {
+            for (((tracer, s), t), l) in configs.iter().zip(&mut times).zip(&mut last) {
                 let t0 = Instant::now();
                 let f = render(scene, tracer, cam, light, s);
                 t.push(t0.elapsed().as_secs_f64());
@@ -214,18 +214,26 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
         let tree = build_tree(scene, &params, a.threads as usize)?;
         let tracer =
             |method, cull| Tracer::new(&tree, None, TraceOptions { method, cull, backend, ..Default::default() });
-        let m = |method: Method, tile: u32, cull: bool| {
-            measure(scene, &tracer(method, cull), cam, *light, &settings(tile), &pool, a.reps)
-        };
         eprintln!("measuring {name} ({} triangles)", scene.triangle_count());
+        // Every configuration of the scene's row, rendered in turn, round by round (`measure_interleaved`).
+        let (packet, unculled) = (tracer(Method::Packet, true), tracer(Method::Frustum, false));
+        let (frustum, mft) = (tracer(Method::Frustum, true), tracer(Method::Mft, true));
+        let (cone, mft_cone) = (tracer(Method::Cone, true), tracer(Method::MftCone, true));
+        let mut configs = vec![(&packet, settings(16)), (&unculled, settings(8))];
+        configs.extend(tiles.iter().map(|&t| (&frustum, settings(t))));
+        configs.extend(tiles.iter().map(|&t| (&mft, settings(t))));
+        configs.extend(tiles[..3].iter().map(|&t| (&cone, settings(t))));
+        configs.extend(tiles[..3].iter().map(|&t| (&mft_cone, settings(t))));
+        let cells = measure_interleaved(scene, cam, *light, &configs, &pool, a.reps);
+        let n = tiles.len();
         rows.push(Row {
             name: name.clone(),
-            packet: m(Method::Packet, 16, true),
-            frustum: tiles.iter().map(|&t| m(Method::Frustum, t, true)).collect(),
-            nocull8: m(Method::Frustum, 8, false),
-            mft: tiles.iter().map(|&t| m(Method::Mft, t, true)).collect(),
-            cone: tiles[..3].iter().map(|&t| m(Method::Cone, t, true)).collect(),
-            mft_cone: tiles[..3].iter().map(|&t| m(Method::MftCone, t, true)).collect(),
+            packet: cells[0],
+            nocull8: cells[1],
+            frustum: cells[2..2 + n].to_vec(),
+            mft: cells[2 + n..2 + 2 * n].to_vec(),
+            cone: cells[2 + 2 * n..5 + 2 * n].to_vec(),
+            mft_cone: cells[5 + 2 * n..8 + 2 * n].to_vec(),
         });
     }
 
@@ -237,7 +245,8 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
         let _ = writeln!(
             md,
             "\n{}x{}, {} threads, {} backend ({}-ray packets), primary rays with the simple shading (one point \
-             light, N.L, attenuation), no shadows, no secondary rays; FPS from the median of {} frames.",
+             light, N.L, attenuation), no shadows, no secondary rays; FPS from the median of {} frames, every \
+             configuration of a scene rendered in turn, round by round.",
             a.width,
             a.height,
             a.threads,
