@@ -16,9 +16,11 @@ use crate::ray::Ray;
 const TOWARD_TOLERANCE: f32 = 1e-3;
 
 impl Tracer<'_> {
-    /// The one bundle of a whole tile, packets `all`: `common` builds it from packets with one origin,
-    /// `toward_fn` from segments that end at a light (function items rather than `Option::or_else`
-    /// closures, whose vector code the compiler may keep out of line).
+    /// The one bundle of a whole tile, packets `all`: `from_origin` builds it when the tile's rays share the
+    /// origin `shared` ([`common_origin`], found once per tile by the caller), `toward_fn` from segments that
+    /// end at a light (function items rather than `Option::or_else` closures, whose vector code the compiler
+    /// may keep out of line).
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(super) fn whole<V: Vf32, B>(
         &self,
@@ -26,10 +28,13 @@ impl Tracer<'_> {
         all: &[usize],
         rays: &[Option<Ray>],
         toward: Option<Vec3>,
-        common: fn(&PacketTile<V>, &[usize]) -> Option<B>,
+        shared: Option<Vec3>,
+        from_origin: fn(Vec3, &PacketTile<V>, &[usize]) -> Option<B>,
         toward_fn: fn(&Bundled<V>, Vec3, f32) -> Option<B>,
     ) -> Option<B> {
-        if let Some(b) = common(tile, all) {
+        if let Some(o) = shared
+            && let Some(b) = from_origin(o, tile, all)
+        {
             return Some(b);
         }
         let (w, h) = (tile.width, tile.height);
@@ -37,15 +42,17 @@ impl Tracer<'_> {
         toward_fn(&whole, toward?, self.options.shadow_spread_limit)
     }
 
-    /// The four quadrant bundles of a tile (in whole packets) and the packets each bounds; `common` builds a
-    /// bundle from packets with one origin, `toward` one from segments that end at a light.
+    /// The four quadrant bundles of a tile (in whole packets) and the packets each bounds; `from_origin` builds
+    /// a bundle from packets with one origin (`shared`, when the whole tile's rays have one, saves looking for
+    /// it per quadrant), `toward` one from segments that end at a light.
     #[inline(always)]
     pub(super) fn quadrants<V: Vf32, B: Copy>(
         &self,
         tile: &PacketTile<V>,
         rays: &[Option<Ray>],
         toward: Option<Vec3>,
-        common: fn(&PacketTile<V>, &[usize]) -> Option<B>,
+        shared: Option<Vec3>,
+        from_origin: fn(Vec3, &PacketTile<V>, &[usize]) -> Option<B>,
         toward_fn: fn(&Bundled<V>, Vec3, f32) -> Option<B>,
     ) -> Option<Quadrants<B>> {
         let (pw, ph) = (PacketTile::<V>::PACKET_W, PacketTile::<V>::PACKET_H);
@@ -65,8 +72,9 @@ impl Tracer<'_> {
             if set.iter().all(|&j| tile.packets[j].valid.none()) {
                 continue;
             }
-            let (b, o) = match common_origin(tile, &set) {
-                Some(o) => (common(tile, &set)?, o),
+            let found = if shared.is_some() { shared } else { common_origin(tile, &set) };
+            let (b, o) = match found {
+                Some(o) => (from_origin(o, tile, &set)?, o),
                 None => {
                     let t = toward?;
                     let rays = RayRect { rays, width: w, x: x0..x1, y: y0..y1 };
@@ -115,10 +123,10 @@ pub(super) fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Opt
     (elsewhere == 0).then_some(origin)
 }
 
-/// The cone of packets `set` when all their rays start at one point, else `None`.
+/// The cone of packets `set`, whose rays all start at `origin` ([`common_origin`]); `None` when none is valid.
 #[inline(always)]
-pub(super) fn common_origin_cone<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Cone> {
-    Cone::from_packets(common_origin(tile, set)?, &tile.packets, set)
+pub(super) fn cone_from<V: Vf32>(origin: Vec3, tile: &PacketTile<V>, set: &[usize]) -> Option<Cone> {
+    Cone::from_packets(origin, &tile.packets, set)
 }
 
 /// The cone, seen from `toward`, of the rays of `b` when they are segments that end there (shadow rays to a
@@ -130,10 +138,11 @@ pub(super) fn toward_cone<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f
     Some(c)
 }
 
-/// The frustum of the packets `set` of `tile` when all their rays start at one point, else `None`.
+/// The frustum of the packets `set` of `tile`, whose rays all start at `origin` ([`common_origin`]); `None`
+/// when none is valid.
 #[inline(always)]
-pub(super) fn common_origin_frustum<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Frustum> {
-    Frustum::from_packets(common_origin(tile, set)?, &tile.packets, set)
+pub(super) fn frustum_from<V: Vf32>(origin: Vec3, tile: &PacketTile<V>, set: &[usize]) -> Option<Frustum> {
+    Frustum::from_packets(origin, &tile.packets, set)
 }
 
 /// A tile's four quadrant bundles (empty quadrants are `None`), the packets each bounds, and the packets left

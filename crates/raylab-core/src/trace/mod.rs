@@ -29,7 +29,7 @@ use crate::reference::BruteForce;
 use crate::render::RayOrder;
 use crate::shadow::EdgeWidth;
 use crate::stats::TraversalStats;
-use bundle::{Bundled, RayRect, common_origin, common_origin_cone, common_origin_frustum, toward_cone, toward_frustum};
+use bundle::{Bundled, RayRect, common_origin, cone_from, frustum_from, toward_cone, toward_frustum};
 use kernels::{EdgeWidthsSimd, IntersectSimd, OccludedSimd};
 
 /// How rays are traced. Serialises into run reports (the backend by its name).
@@ -362,29 +362,28 @@ impl<'a> Tracer<'a> {
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         // Tiles no bundle covers are traced as packets (after the match, so the packet kernel is inlined once).
         let cull = self.options.cull;
-        if cull
-            && self.options.method.is_bundled()
-            && let Some(origin) = common_origin(tile, all)
-        {
+        // The rays' common origin, found once for the tile: every bundle of its packets starts there.
+        let shared = if self.options.method.is_bundled() { common_origin(tile, all) } else { None };
+        if cull && let Some(origin) = shared {
             tile.share_origin(origin);
         }
-        let bundled = match self.options.method {
-            Method::Frustum => {
-                let f = common_origin_frustum(tile, all);
+        let bundled = match (self.options.method, shared) {
+            (Method::Frustum, Some(o)) => {
+                let f = frustum_from(o, tile, all);
                 if let Some(f) = &f {
                     self.tree.intersect_frustum(f, tile, all, cull, stats);
                 }
                 f.is_some()
             }
-            Method::Cone => {
-                let c = common_origin_cone(tile, all);
+            (Method::Cone, Some(o)) => {
+                let c = cone_from(o, tile, all);
                 if let Some(c) = &c {
                     self.tree.intersect_frustum(c, tile, all, cull, stats);
                 }
                 c.is_some()
             }
-            Method::Mft => {
-                if let Some((b, sets, _)) = self.quadrants(tile, rays, None, common_origin_frustum, toward_frustum)
+            (Method::Mft, _) => {
+                if let Some((b, sets, _)) = self.quadrants(tile, rays, None, shared, frustum_from, toward_frustum)
                     && let Some(f4) = Frustum4::new(b)
                 {
                     self.tree.intersect_mft(&f4, tile, &sets, cull, stats);
@@ -393,8 +392,8 @@ impl<'a> Tracer<'a> {
                     false
                 }
             }
-            Method::MftCone => {
-                if let Some((b, sets, _)) = self.quadrants(tile, rays, None, common_origin_cone, toward_cone)
+            (Method::MftCone, _) => {
+                if let Some((b, sets, _)) = self.quadrants(tile, rays, None, shared, cone_from, toward_cone)
                     && let Some(c4) = Frustum4::new(b)
                 {
                     self.tree.intersect_mft(&c4, tile, &sets, cull, stats);
@@ -447,9 +446,10 @@ impl<'a> Tracer<'a> {
         all.clear();
         all.extend(0..tile.packets.len());
         let all = &all[..];
+        // The rays' common origin when they have one (camera rays), found once for the tile.
+        let shared = if self.options.method.is_bundled() { common_origin(tile, all) } else { None };
         if self.options.cull
-            && self.options.method.is_bundled()
-            && let Some(origin) = common_origin(tile, all)
+            && let Some(origin) = shared
         {
             tile.share_origin(origin);
         }
@@ -460,15 +460,15 @@ impl<'a> Tracer<'a> {
         let mut rest: Option<Vec<usize>> = None;
         let mut all_left = false;
         match self.options.method {
-            Method::Frustum => match self.whole(tile, all, rays, toward, common_origin_frustum, toward_frustum) {
+            Method::Frustum => match self.whole(tile, all, rays, toward, shared, frustum_from, toward_frustum) {
                 Some(f) => self.tree.occluded_frustum(&f, tile, all, self.options.cull, blocked, stats),
                 None => all_left = true,
             },
-            Method::Cone => match self.whole(tile, all, rays, toward, common_origin_cone, toward_cone) {
+            Method::Cone => match self.whole(tile, all, rays, toward, shared, cone_from, toward_cone) {
                 Some(c) => self.tree.occluded_frustum(&c, tile, all, self.options.cull, blocked, stats),
                 None => all_left = true,
             },
-            Method::Mft => match self.quadrants(tile, rays, toward, common_origin_frustum, toward_frustum) {
+            Method::Mft => match self.quadrants(tile, rays, toward, shared, frustum_from, toward_frustum) {
                 Some((b, sets, left)) => {
                     if let Some(f4) = Frustum4::new(b) {
                         self.tree.occluded_mft(&f4, tile, &sets, self.options.cull, blocked, stats);
@@ -477,7 +477,7 @@ impl<'a> Tracer<'a> {
                 }
                 None => all_left = true,
             },
-            Method::MftCone => match self.quadrants(tile, rays, toward, common_origin_cone, toward_cone) {
+            Method::MftCone => match self.quadrants(tile, rays, toward, shared, cone_from, toward_cone) {
                 Some((b, sets, left)) => {
                     if let Some(c4) = Frustum4::new(b) {
                         self.tree.occluded_mft(&c4, tile, &sets, self.options.cull, blocked, stats);
