@@ -139,7 +139,8 @@ impl<V: Vf32> PacketTile<V> {
         }
     }
 
-    /// The first packet column and row of the right and bottom quadrants ([`quadrant_split`]).
+    /// The first packet column and row of the right and bottom quadrants: the left and top ones take the
+    /// larger half of an odd count.
     #[inline(always)]
     pub fn quadrant_split(&self) -> (usize, usize) {
         quadrant_split(self.cols, self.rows)
