@@ -374,6 +374,20 @@ mod tests {
             let mut one = [f32::NAN; 16];
             one[n - 1] = -3.5;
             assert_eq!((V::from_slice(&one[..n]).reduce_min(), V::from_slice(&one[..n]).reduce_max()), (-3.5, -3.5));
+            // NaN in any set of lanes is skipped by both reductions, wherever the extremes sit.
+            let values = [3.0f32, -1.5, 8.0, 0.25, -7.0, 2.0, 5.5, -0.5, 9.5, 1.0, -3.0, 4.0, 6.0, -2.5, 0.5, 7.5];
+            for nan in (0..1u32 << n).step_by(n / 4 * n / 4) {
+                let lanes: Vec<f32> = (0..n).map(|i| if nan >> i & 1 == 1 { f32::NAN } else { values[i] }).collect();
+                let kept: Vec<f32> = lanes.iter().copied().filter(|x| !x.is_nan()).collect();
+                let v = V::from_slice(&lanes);
+                if kept.is_empty() {
+                    assert!(v.reduce_min().is_nan() && v.reduce_max().is_nan());
+                } else {
+                    let (lo, hi) =
+                        kept.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), &x| (l.min(x), h.max(x)));
+                    assert_eq!((v.reduce_min(), v.reduce_max()), (lo, hi), "NaN lanes {nan:#b}");
+                }
+            }
             let mut spread = [1.0f32; 16];
             (spread[1], spread[n - 2]) = (f32::INFINITY, f32::NEG_INFINITY);
             let inf = V::from_slice(&spread[..n]);

@@ -87,6 +87,23 @@ arith!(Sub, sub, _mm_sub_ps);
 arith!(Mul, mul, _mm_mul_ps);
 arith!(Div, div, _mm_div_ps);
 
+impl F32x4 {
+    /// Folds the lanes with `op` (a lane-wise min or max) in registers: the two halves, then the last two
+    /// lanes. NaN lanes are first replaced by `identity`, so they are ignored; all-NaN input gives NaN (the
+    /// trait's lane-by-lane default, which stores the register and reloads each lane, cost packet/leaf culling
+    /// setup a tenth of an SSE frame).
+    #[inline(always)]
+    fn reduce(self, identity: f32, op: impl Fn(__m128, __m128) -> __m128) -> f32 {
+        sse!({
+            let ordered = _mm_cmpord_ps(self.0, self.0);
+            let v = _mm_or_ps(_mm_and_ps(ordered, self.0), _mm_andnot_ps(ordered, _mm_set1_ps(identity)));
+            let m = op(v, _mm_movehl_ps(v, v));
+            let m = op(m, _mm_shuffle_ps::<0b01>(m, m));
+            if _mm_movemask_ps(ordered) == 0 { f32::NAN } else { _mm_cvtss_f32(m) }
+        })
+    }
+}
+
 impl Vf32 for F32x4 {
     type Mask = M32x4;
     const LANES: usize = 4;
@@ -143,6 +160,14 @@ impl Vf32 for F32x4 {
     #[inline(always)]
     fn select(m: M32x4, a: Self, b: Self) -> Self {
         Self(sse!(_mm_or_ps(_mm_and_ps(m.0, a.0), _mm_andnot_ps(m.0, b.0))))
+    }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        self.reduce(f32::INFINITY, |a, b| sse!(_mm_min_ps(a, b)))
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        self.reduce(f32::NEG_INFINITY, |a, b| sse!(_mm_max_ps(a, b)))
     }
     #[inline(always)]
     fn abs(self) -> Self {
