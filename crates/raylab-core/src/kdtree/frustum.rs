@@ -8,6 +8,8 @@
 //! leaf's box (culling, switchable) and then against the leaf's triangles. Entries on the stack that start
 //! beyond every ray's closest hit are skipped, which ends the walk once all rays have hit.
 
+use std::ops::Range;
+
 use raylab_simd::{VMask, Vf32};
 
 use super::mono::SPLIT_SLACK;
@@ -88,27 +90,36 @@ impl<const SLOTS: usize> BatchBits<SLOTS> {
     }
 }
 
-/// A set of a tile's packets as one bit mask per chunk of [`Vf32::LANES`] packets (the chunks of
-/// [`crate::packet::BatchCull`]), so a leaf test checks a whole chunk's packets with a few vector and bit
-/// operations and visits only those left: at most leaves, most of a frustum's packets are culled (Table 4.2).
+/// A run of a tile's packets seen as chunks of [`Vf32::LANES`] packets (the chunks of
+/// [`crate::packet::BatchCull`]), one bit per member, so a leaf test checks a whole chunk's packets with a few
+/// vector and bit operations and visits only those left: at most leaves, most of a frustum's packets are
+/// culled (Table 4.2). A bundle bounds a run of its tile's packets (the whole tile, or an MFT quadrant in the
+/// tile's quadrant-major order), so a set costs nothing to build.
+#[derive(Clone, Debug)]
 pub(super) struct ChunkSet {
-    /// `(chunk, members)`: bit `i` of `members` for packet `chunk * LANES + i`, in the order the set first
-    /// names each chunk.
-    chunks: Vec<(usize, u32)>,
+    packets: Range<usize>,
 }
 
 impl ChunkSet {
-    /// The chunks of packets `set` for lane type `V`.
-    pub fn new<V: Vf32>(set: &[usize]) -> Self {
-        let mut chunks: Vec<(usize, u32)> = Vec::with_capacity(set.len());
-        for &j in set {
-            let (chunk, bit) = (j / V::LANES, 1u32 << (j % V::LANES));
-            match chunks.iter_mut().rev().find(|(c, _)| *c == chunk) {
-                Some((_, members)) => *members |= bit,
-                None => chunks.push((chunk, bit)),
-            }
-        }
-        Self { chunks }
+    /// The packets `packets`.
+    #[inline(always)]
+    pub fn new(packets: Range<usize>) -> Self {
+        Self { packets }
+    }
+
+    /// The chunks that hold a member, for lane type `V`.
+    #[inline(always)]
+    fn chunks<V: Vf32>(&self) -> Range<usize> {
+        let Range { start, end } = self.packets;
+        if start < end { start / V::LANES..end.div_ceil(V::LANES) } else { 0..0 }
+    }
+
+    /// The members of chunk `chunk` (one of [`ChunkSet::chunks`]): bit `i` for packet `chunk * LANES + i`.
+    #[inline(always)]
+    fn members<V: Vf32>(&self, chunk: usize) -> u32 {
+        let base = chunk * V::LANES;
+        let (lo, hi) = (self.packets.start.max(base) - base, self.packets.end.min(base + V::LANES) - base);
+        ((1u32 << hi) - 1) & !((1u32 << lo) - 1)
     }
 }
 
@@ -131,7 +142,8 @@ pub(super) fn leaf_intersect<V: Vf32, const SLOTS: usize>(
     let bounds = &tree.leaf_bounds(leaf.node);
     let mut changed = false;
     let done_before = leaf.near * (1.0 - SPLIT_SLACK);
-    for &(chunk, members) in &set.chunks {
+    for chunk in set.chunks::<V>() {
+        let members = set.members::<V>(chunk);
         // Packets whose rays all hit before the leaf starts (nothing here can be closer), then those whose rays
         // certainly miss its box, leave the chunk's bits.
         let first = chunk * V::LANES;
@@ -200,8 +212,8 @@ pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
     }
     let bounds = &tree.leaf_bounds(leaf.node);
     let mut finished = 0;
-    for &(chunk, members) in &set.chunks {
-        let mut bits = members;
+    for chunk in set.chunks::<V>() {
+        let mut bits = set.members::<V>(chunk);
         while bits != 0 {
             let lane = bits.trailing_zeros();
             bits &= bits - 1;
@@ -284,11 +296,11 @@ impl<V: Vf32> FrustumLeaf for BlockedLeaves<'_, V> {
 
 /// How many packets of `set` have a lane that is not blocked yet.
 #[inline(always)]
-pub(super) fn open_packets<V: Vf32>(tile: &PacketTile<V>, set: &[usize], blocked: &[V::Mask]) -> usize {
+pub(super) fn open_packets<V: Vf32>(tile: &PacketTile<V>, set: Range<usize>, blocked: &[V::Mask]) -> usize {
     // A plain loop: an iterator adapter may stay out of line, compiled without the kernel's instruction set
     // (see `crate::packet::map3`).
     let mut open = 0;
-    for &j in set {
+    for j in set {
         open += (tile.packets[j].valid & !blocked[j]).any() as usize;
     }
     open
@@ -299,10 +311,11 @@ pub(super) fn open_packets<V: Vf32>(tile: &PacketTile<V>, set: &[usize], blocked
 #[inline(always)]
 pub(super) fn hit_limit<V: Vf32>(tile: &PacketTile<V>, set: &ChunkSet) -> f32 {
     let mut limit = V::splat(0.0);
-    for &(chunk, members) in &set.chunks {
+    for chunk in set.chunks::<V>() {
         let first = chunk * V::LANES;
         let farthest = V::from_slice(&tile.farthest_hit[first..first + V::LANES]);
-        limit = limit.max(V::select(V::Mask::from_bits(members), farthest, V::splat(f32::NEG_INFINITY)));
+        limit =
+            limit.max(V::select(V::Mask::from_bits(set.members::<V>(chunk)), farthest, V::splat(f32::NEG_INFINITY)));
     }
     limit.reduce_max()
 }
@@ -315,11 +328,11 @@ impl KdTree {
         &self,
         f: &B,
         tile: &mut PacketTile<V>,
-        set: &[usize],
+        set: Range<usize>,
         cull: bool,
         stats: &mut TraversalStats,
     ) {
-        let chunks = ChunkSet::new::<V>(set);
+        let chunks = ChunkSet::new(set);
         self.traverse_frustum(f, stats, &mut ClosestLeaves { tile, chunks, cull, limit: f32::INFINITY });
     }
 
@@ -330,13 +343,13 @@ impl KdTree {
         &self,
         f: &B,
         tile: &PacketTile<V>,
-        set: &[usize],
+        set: Range<usize>,
         cull: bool,
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
-        let open = open_packets(tile, set, blocked);
-        let set = ChunkSet::new::<V>(set);
+        let open = open_packets(tile, set.clone(), blocked);
+        let set = ChunkSet::new(set);
         self.traverse_frustum(f, stats, &mut BlockedLeaves { tile, set, cull, blocked, open });
     }
 
@@ -398,12 +411,20 @@ mod tests {
 
     use super::*;
 
-    /// Packets fall into chunks of four (the scalar lane type's width) whatever order the set names them in,
-    /// each packet once, chunks in the order of their first packet.
+    /// A run of packets falls into the chunks of four (the scalar lane type's width) that hold it, each
+    /// packet once; an empty run has none.
     #[test]
     fn chunk_sets_hold_every_packet_once() {
-        let set = ChunkSet::new::<F32x4>(&[5, 0, 1, 9, 4, 15, 12]);
-        assert_eq!(set.chunks, vec![(1, 0b0011), (0, 0b0011), (2, 0b0010), (3, 0b1001)]);
-        assert!(ChunkSet::new::<F32x4>(&[]).chunks.is_empty());
+        for (start, end) in [(0, 16), (5, 13), (3, 4), (4, 8), (7, 9), (0, 1)] {
+            let set = ChunkSet::new(start..end);
+            let mut got = Vec::new();
+            for chunk in set.chunks::<F32x4>() {
+                let members = set.members::<F32x4>(chunk);
+                assert_ne!(members, 0, "{start}..{end}: chunk {chunk} holds no member");
+                got.extend((0..4).filter(|i| members >> i & 1 == 1).map(|i| chunk * 4 + i));
+            }
+            assert_eq!(got, (start..end).collect::<Vec<_>>(), "{start}..{end}");
+        }
+        assert!(ChunkSet::new(6..6).chunks::<F32x4>().is_empty());
     }
 }

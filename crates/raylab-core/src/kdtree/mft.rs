@@ -8,6 +8,8 @@
 //! one of [`super::frustum`], done for four frustums at once, in the backend's four-lane vectors
 //! ([`Vf32::Quad`]) whatever the width of the packets.
 
+use std::ops::Range;
+
 use raylab_simd::{VMask, Vf32};
 
 use super::frustum::{BatchBits, ChunkSet, Leaf, front_child, hit_limit, leaf_intersect, leaf_occlude, open_packets};
@@ -149,16 +151,11 @@ impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
     }
 }
 
-/// The four frustums' packet sets as [`ChunkSet`]s (written out rather than with `array::map`, which may stay
-/// out of line; see `map3`).
+/// The four frustums' packet runs as [`ChunkSet`]s.
 #[inline(always)]
-fn chunk_sets<V: Vf32>(sets: &[Vec<usize>; 4]) -> [ChunkSet; 4] {
-    [
-        ChunkSet::new::<V>(&sets[0]),
-        ChunkSet::new::<V>(&sets[1]),
-        ChunkSet::new::<V>(&sets[2]),
-        ChunkSet::new::<V>(&sets[3]),
-    ]
+fn chunk_sets(sets: &[Range<usize>; 4]) -> [ChunkSet; 4] {
+    let [a, b, c, d] = sets.clone();
+    [ChunkSet::new(a), ChunkSet::new(b), ChunkSet::new(c), ChunkSet::new(d)]
 }
 
 /// A pending child: its node, the four frustums' intervals there and the frustums that reach it.
@@ -173,40 +170,40 @@ struct Entry<Q: Vf32> {
 const STACK: usize = KdParams::DEPTH_LIMIT as usize + 4;
 
 impl KdTree {
-    /// Closest hits of the packets of `tile`; `sets[i]` lists the packets that frustum lane `i` bounds.
+    /// Closest hits of the packets of `tile`; `sets[i]` is the run of packets that frustum lane `i` bounds.
     #[inline(always)]
     pub fn intersect_mft<V: Vf32>(
         &self,
         f: &Frustum4<V>,
         tile: &mut PacketTile<V>,
-        sets: &[Vec<usize>; 4],
+        sets: &[Range<usize>; 4],
         cull: bool,
         stats: &mut TraversalStats,
     ) {
-        let chunks = chunk_sets::<V>(sets);
+        let chunks = chunk_sets(sets);
         self.traverse_mft(f, stats, &mut ClosestLeaves { tile, chunks, cull, limit: [f32::INFINITY; 4] });
     }
 
-    /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` lists the packets
-    /// that frustum lane `i` bounds.
+    /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` is the run of
+    /// packets that frustum lane `i` bounds.
     #[inline(always)]
     pub fn occluded_mft<V: Vf32>(
         &self,
         f: &Frustum4<V>,
         tile: &PacketTile<V>,
-        sets: &[Vec<usize>; 4],
+        sets: &[Range<usize>; 4],
         cull: bool,
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
         // Written out rather than with `array::from_fn`, which may stay out of line (see `map3`).
         let open = [
-            open_packets(tile, &sets[0], blocked),
-            open_packets(tile, &sets[1], blocked),
-            open_packets(tile, &sets[2], blocked),
-            open_packets(tile, &sets[3], blocked),
+            open_packets(tile, sets[0].clone(), blocked),
+            open_packets(tile, sets[1].clone(), blocked),
+            open_packets(tile, sets[2].clone(), blocked),
+            open_packets(tile, sets[3].clone(), blocked),
         ];
-        let sets = chunk_sets::<V>(sets);
+        let sets = chunk_sets(sets);
         self.traverse_mft(f, stats, &mut BlockedLeaves { tile, sets, cull, blocked, open, done: 0 });
     }
 

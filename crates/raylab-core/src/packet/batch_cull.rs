@@ -38,12 +38,23 @@ impl BatchCull {
     /// The batch data of `packets`, whose valid rays all start at `origin`, in chunks of `V::LANES` packets.
     #[inline(always)]
     pub fn new<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>]) -> Self {
+        let mut batch = BatchCull { origin, chunks: Vec::new() };
+        batch.rebuild(origin, packets);
+        batch
+    }
+
+    /// [`BatchCull::new`] in place, keeping the buffer: a tile of a frustum method rebuilds it for every tile.
+    #[inline(always)]
+    pub fn rebuild<V: Vf32>(&mut self, origin: Vec3, packets: &[RayPacket<V>]) {
         let empty = Chunk {
             inv_lo: [[f32::NAN; MAX_LANES]; 3],
             inv_hi: [[f32::NAN; MAX_LANES]; 3],
             tmin: [f32::INFINITY; MAX_LANES],
         };
-        let mut chunks = vec![empty; packets.len().div_ceil(V::LANES)];
+        self.origin = origin;
+        let chunks = &mut self.chunks;
+        chunks.clear();
+        chunks.resize(packets.len().div_ceil(V::LANES), empty);
         let (inf, ninf) = (V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
         for (j, p) in packets.iter().enumerate() {
             if p.valid.none() {
@@ -59,7 +70,6 @@ impl BatchCull {
                 }
             }
         }
-        BatchCull { origin, chunks }
     }
 
     /// Bits (lane `i` for packet `chunk * LANES + i`) of the packets of one chunk that may have a ray inside

@@ -106,14 +106,13 @@ impl Cone {
         }
     }
 
-    /// The cone of the valid rays of `packets[set]`, which all start at `origin`.
+    /// The cone of the valid rays of `packets`, which all start at `origin`.
     #[inline(always)]
-    pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>], set: &[usize]) -> Option<Self> {
+    pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>]) -> Option<Self> {
         // The lanes are read out here, in a plain loop, so that no vector code runs inside `bounding`'s
         // iterator, which the compiler may keep out of line (see `map3`).
-        let mut segs = Vec::with_capacity(set.len() * V::LANES);
-        for &j in set {
-            let p = &packets[j];
+        let mut segs = Vec::with_capacity(packets.len() * V::LANES);
+        for p in packets {
             let bits = p.valid.bits();
             for i in (0..V::LANES).filter(|i| bits >> i & 1 == 1) {
                 let r = p.ray(i);

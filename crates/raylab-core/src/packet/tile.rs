@@ -1,6 +1,8 @@
 //! A tile of rays cut into 2x2 packets (4x2 with eight lanes, 4x4 with sixteen), the unit that frustum kernels
 //! trace and cull (thesis 4.1.3-4.1.5).
 
+use std::ops::Range;
+
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
@@ -34,6 +36,8 @@ pub struct PacketTile<V: Vf32> {
     pub farthest_hit: Vec<f32>,
     /// The batched culling data, once [`PacketTile::share_origin`] has found the rays' common origin.
     pub batch: Option<BatchCull>,
+    /// The last batch data, kept for its buffer while the tile holds none.
+    spare_batch: Option<BatchCull>,
     /// Index of each packet's lane-0 pixel in the tile, and the tile width, to map lanes back to pixels.
     pub origin_pixel: Vec<(usize, usize)>,
     /// Packet columns and rows.
@@ -67,6 +71,7 @@ impl<V: Vf32> PacketTile<V> {
             hits: Vec::new(),
             farthest_hit: Vec::new(),
             batch: None,
+            spare_batch: None,
             origin_pixel: Vec::new(),
             cols: 0,
             rows: 0,
@@ -82,7 +87,10 @@ impl<V: Vf32> PacketTile<V> {
     pub fn refill(&mut self, rays: &[Option<Ray>], width: usize, height: usize) {
         let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
         let (cols, rows) = (width.div_ceil(pw), height.div_ceil(ph));
-        (self.cols, self.rows, self.width, self.height, self.batch) = (cols, rows, width, height, None);
+        (self.cols, self.rows, self.width, self.height) = (cols, rows, width, height);
+        if let Some(batch) = self.batch.take() {
+            self.spare_batch = Some(batch);
+        }
         let n = cols * rows;
         let (packets, origin_pixel, hits, farthest_hit) =
             (&mut self.packets, &mut self.origin_pixel, &mut self.hits, &mut self.farthest_hit);
@@ -125,7 +133,13 @@ impl<V: Vf32> PacketTile<V> {
     /// has checked that they do).
     #[inline(always)]
     pub fn share_origin(&mut self, origin: Vec3) {
-        self.batch = Some(BatchCull::new(origin, &self.packets));
+        self.batch = Some(match self.spare_batch.take() {
+            Some(mut batch) => {
+                batch.rebuild(origin, &self.packets);
+                batch
+            }
+            None => BatchCull::new(origin, &self.packets),
+        });
     }
 
     /// Calls `f(pixel_index, lane)` for every lane of packet `j` that holds a ray.
@@ -157,19 +171,15 @@ impl<V: Vf32> PacketTile<V> {
         before + (by - y0) * qw + bx - x0
     }
 
-    /// Indices of the packets inside the pixel rectangle `[x0, x1) x [y0, y1)` (packet-aligned), ascending.
+    /// Each quadrant's packets (top left, top right, bottom left, bottom right), as the run of indices the
+    /// storage order gives it; an empty quadrant (one packet column or row) has an empty run. Runs rather than
+    /// lists of indices cost MFT nothing to build per tile.
     #[inline(always)]
-    pub fn packets_in(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> Vec<usize> {
-        let (pw, ph) = (Self::PACKET_W, Self::PACKET_H);
-        let (ys, xs) = (y0 / ph..y1.div_ceil(ph).min(self.rows), x0 / pw..x1.div_ceil(pw).min(self.cols));
-        let mut v = Vec::with_capacity(ys.len() * xs.len());
-        for by in ys {
-            for bx in xs.clone() {
-                v.push(self.packet_index(bx, by));
-            }
-        }
-        v.sort_unstable();
-        v
+    pub fn quadrant_packets(&self) -> [Range<usize>; 4] {
+        let (sx, sy) = self.quadrant_split();
+        let (cols, rows) = (self.cols, self.rows);
+        let ends = [sx * sy, sy * cols, sy * cols + sx * (rows - sy), cols * rows];
+        [0..ends[0], ends[0]..ends[1], ends[1]..ends[2], ends[2]..ends[3]]
     }
 }
 
@@ -359,10 +369,10 @@ impl Frustum {
         Self::bounding(apex, [(lo, 0.0, span.depth), (hi, 0.0, span.depth)])
     }
 
-    /// The frustum of the valid rays of `packets[set]`, which must all start at `origin`, from the packets'
+    /// The frustum of the valid rays of `packets`, which must all start at `origin`, from the packets'
     /// inverse directions (no division per ray).
     #[inline(always)]
-    pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>], set: &[usize]) -> Option<Self> {
+    pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>]) -> Option<Self> {
         let inf = V::splat(f32::INFINITY);
         let ninf = V::splat(f32::NEG_INFINITY);
         let zero = V::splat(0.0);
@@ -370,8 +380,7 @@ impl Frustum {
         let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
         let (mut t_min, mut t_max) = (inf, ninf);
         let mut any = false;
-        for &j in set {
-            let p = &packets[j];
+        for p in packets {
             if p.valid.none() {
                 continue;
             }
@@ -495,12 +504,18 @@ mod tests {
                 let (sx, sy) = t.quadrant_split();
                 let (cx, cy) = (sx * pw, sy * ph);
                 let mut next = 0;
-                for (x0, y0, x1, y1) in [(0, 0, cx, cy), (cx, 0, w, cy), (0, cy, cx, h), (cx, cy, w, h)] {
-                    let set = if x0 < x1 && y0 < y1 { t.packets_in(x0, y0, x1, y1) } else { Vec::new() };
-                    assert_eq!(set, (next..next + set.len()).collect::<Vec<_>>(), "{w}x{h} quadrant at ({x0}, {y0})");
-                    next += set.len();
+                let rects = [(0, 0, cx, cy), (cx, 0, w, cy), (0, cy, cx, h), (cx, cy, w, h)];
+                for (run, (x0, y0, x1, y1)) in t.quadrant_packets().into_iter().zip(rects) {
+                    assert_eq!(run.start, next, "{w}x{h}: quadrant at ({x0}, {y0}) follows the one before");
+                    let inside = (y0..y1).step_by(ph).flat_map(|y| (x0..x1).step_by(pw).map(move |x| (x, y)));
+                    let mut want: Vec<_> = inside.collect();
+                    let mut got: Vec<_> = run.clone().map(|j| t.origin_pixel[j]).collect();
+                    want.sort_unstable();
+                    got.sort_unstable();
+                    assert_eq!(got, want, "{w}x{h}: the packets of the quadrant at ({x0}, {y0})");
+                    next = run.end;
                     if t.cols.is_multiple_of(2) && t.rows.is_multiple_of(2) && (sx * sy).is_multiple_of(V::LANES) {
-                        assert_eq!(set[0] % V::LANES, 0, "{w}x{h}: quadrants of whole chunks");
+                        assert_eq!(run.start % V::LANES, 0, "{w}x{h}: quadrants of whole chunks");
                     }
                 }
                 assert_eq!(next, t.packets.len(), "{w}x{h}: the quadrants cover the tile");

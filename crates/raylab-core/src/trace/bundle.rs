@@ -25,15 +25,15 @@ impl Tracer<'_> {
     pub(super) fn whole<V: Vf32, B>(
         &self,
         tile: &PacketTile<V>,
-        all: &[usize],
+        all: Range<usize>,
         rays: &[Option<Ray>],
         toward: Option<Vec3>,
         shared: Option<Vec3>,
-        from_origin: fn(Vec3, &PacketTile<V>, &[usize]) -> Option<B>,
+        from_origin: fn(Vec3, &PacketTile<V>, Range<usize>) -> Option<B>,
         toward_fn: fn(&Bundled<V>, Vec3, f32) -> Option<B>,
     ) -> Option<B> {
         if let Some(o) = shared
-            && let Some(b) = from_origin(o, tile, all)
+            && let Some(b) = from_origin(o, tile, all.clone())
         {
             return Some(b);
         }
@@ -52,37 +52,35 @@ impl Tracer<'_> {
         rays: &[Option<Ray>],
         toward: Option<Vec3>,
         shared: Option<Vec3>,
-        from_origin: fn(Vec3, &PacketTile<V>, &[usize]) -> Option<B>,
+        from_origin: fn(Vec3, &PacketTile<V>, Range<usize>) -> Option<B>,
         toward_fn: fn(&Bundled<V>, Vec3, f32) -> Option<B>,
     ) -> Option<Quadrants<B>> {
         let (pw, ph) = (PacketTile::<V>::PACKET_W, PacketTile::<V>::PACKET_H);
         let (cx, cy) = tile.quadrant_split();
         let (cx, cy) = (cx * pw, cy * ph);
         let (w, h) = (tile.width, tile.height);
-        let quads = [(0, 0, cx.min(w), cy.min(h)), (cx, 0, w, cy.min(h)), (0, cy, cx.min(w), h), (cx, cy, w, h)];
-        let mut sets: [Vec<usize>; 4] = Default::default();
+        let rects = [(0, 0, cx.min(w), cy.min(h)), (cx, 0, w, cy.min(h)), (0, cy, cx.min(w), h), (cx, cy, w, h)];
+        let runs = tile.quadrant_packets();
+        let mut sets: [Range<usize>; 4] = Default::default();
+        let mut rest: [Range<usize>; 4] = Default::default();
         let mut bundles = [None; 4];
-        let mut rest = Vec::new();
         let mut origin = None;
-        for (i, &(x0, y0, x1, y1)) in quads.iter().enumerate() {
-            if x0 >= x1 || y0 >= y1 {
+        for (i, &(x0, y0, x1, y1)) in rects.iter().enumerate() {
+            let set = runs[i].clone();
+            if tile.packets[set.clone()].iter().all(|p| p.valid.none()) {
                 continue;
             }
-            let set = tile.packets_in(x0, y0, x1, y1);
-            if set.iter().all(|&j| tile.packets[j].valid.none()) {
-                continue;
-            }
-            let found = if shared.is_some() { shared } else { common_origin(tile, &set) };
+            let found = if shared.is_some() { shared } else { common_origin(&tile.packets[set.clone()]) };
             let (b, o) = match found {
-                Some(o) => (from_origin(o, tile, &set)?, o),
+                Some(o) => (from_origin(o, tile, set.clone())?, o),
                 None => {
                     let t = toward?;
                     let rays = RayRect { rays, width: w, x: x0..x1, y: y0..y1 };
-                    match toward_fn(&Bundled { tile, set: &set, rays }, t, self.options.shadow_spread_limit) {
+                    match toward_fn(&Bundled { tile, set: set.clone(), rays }, t, self.options.shadow_spread_limit) {
                         Some(b) => (b, t),
                         None => {
                             // Too wide (or not ending at the light): its packets go the packet way.
-                            rest.extend(set);
+                            rest[i] = set;
                             continue;
                         }
                     }
@@ -99,13 +97,12 @@ impl Tracer<'_> {
     }
 }
 
-/// The origin shared by every valid ray of packets `set`, if there is one.
+/// The origin shared by every valid ray of `packets`, if there is one.
 #[inline(always)]
-pub(super) fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Option<Vec3> {
+pub(super) fn common_origin<V: Vf32>(packets: &[RayPacket<V>]) -> Option<Vec3> {
     // A plain loop rather than `find_map`, so the vector code stays inlined (see `map3`).
     let mut found = None;
-    for &j in set {
-        let p = &tile.packets[j];
+    for p in packets {
         let first = p.valid.bits().trailing_zeros() as usize;
         if first < V::LANES {
             found = Some(p.ray(first).origin);
@@ -115,8 +112,7 @@ pub(super) fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Opt
     let origin = found?;
     let o = [V::splat(origin.x), V::splat(origin.y), V::splat(origin.z)];
     let mut elsewhere = 0;
-    for &j in set {
-        let p = &tile.packets[j];
+    for p in packets {
         let at_origin = p.org[0].eq(o[0]) & p.org[1].eq(o[1]) & p.org[2].eq(o[2]);
         elsewhere |= (p.valid & !at_origin).bits();
     }
@@ -125,8 +121,8 @@ pub(super) fn common_origin<V: Vf32>(tile: &PacketTile<V>, set: &[usize]) -> Opt
 
 /// The cone of packets `set`, whose rays all start at `origin` ([`common_origin`]); `None` when none is valid.
 #[inline(always)]
-pub(super) fn cone_from<V: Vf32>(origin: Vec3, tile: &PacketTile<V>, set: &[usize]) -> Option<Cone> {
-    Cone::from_packets(origin, &tile.packets, set)
+pub(super) fn cone_from<V: Vf32>(origin: Vec3, tile: &PacketTile<V>, set: Range<usize>) -> Option<Cone> {
+    Cone::from_packets(origin, &tile.packets[set])
 }
 
 /// The cone, seen from `toward`, of the rays of `b` when they are segments that end there (shadow rays to a
@@ -141,18 +137,19 @@ pub(super) fn toward_cone<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f
 /// The frustum of the packets `set` of `tile`, whose rays all start at `origin` ([`common_origin`]); `None`
 /// when none is valid.
 #[inline(always)]
-pub(super) fn frustum_from<V: Vf32>(origin: Vec3, tile: &PacketTile<V>, set: &[usize]) -> Option<Frustum> {
-    Frustum::from_packets(origin, &tile.packets, set)
+pub(super) fn frustum_from<V: Vf32>(origin: Vec3, tile: &PacketTile<V>, set: Range<usize>) -> Option<Frustum> {
+    Frustum::from_packets(origin, &tile.packets[set])
 }
 
-/// A tile's four quadrant bundles (empty quadrants are `None`), the packets each bounds, and the packets left
-/// to trace as packets.
-type Quadrants<B> = ([Option<B>; 4], [Vec<usize>; 4], Vec<usize>);
+/// A tile's four quadrant bundles, the run of packets each bounds, and the runs left to trace as packets
+/// (quadrants too wide for a bundle). A quadrant without a bundle has an empty run; one without valid rays
+/// is in neither.
+type Quadrants<B> = ([Option<B>; 4], [Range<usize>; 4], [Range<usize>; 4]);
 
-/// The rays a bundle is to bound: packets `set` of `tile`, which hold the valid rays of `rays`.
+/// The rays a bundle is to bound: the run of packets `set` of `tile`, which hold the valid rays of `rays`.
 pub(super) struct Bundled<'a, V: Vf32> {
     pub(super) tile: &'a PacketTile<V>,
-    pub(super) set: &'a [usize],
+    pub(super) set: Range<usize>,
     pub(super) rays: RayRect<'a>,
 }
 
@@ -217,14 +214,14 @@ fn toward_segments(rays: RayRect, toward: Vec3, spread_limit: f32) -> Option<(Ve
 /// test is summed in another order, which can move a bundle right at the spread limit to the packet side.
 #[inline(always)]
 pub(super) fn toward_frustum<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f32) -> Option<Frustum> {
-    let (tile, set) = (b.tile, b.set);
+    let (tile, set) = (b.tile, b.set.clone());
     let (zero, inf, ninf) = (V::splat(0.0), V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
     let tw = [V::splat(toward.x), V::splat(toward.y), V::splat(toward.z)];
     let (mut gap_max, mut t_max) = (zero, ninf);
     let (mut pos_near, mut pos_far, mut neg_near, mut neg_far) = ([inf; 3], [ninf; 3], [ninf; 3], [inf; 3]);
     let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
     let mut sum = [zero; 3];
-    for p in set.iter().map(|&j| &tile.packets[j]).filter(|p| p.valid.any()) {
+    for p in tile.packets[set.clone()].iter().filter(|p| p.valid.any()) {
         let valid = p.valid;
         let (d, len, gap) = toward_segment(p, &tw);
         let far_end = !p.tmax.abs().lt(inf);
@@ -259,7 +256,7 @@ pub(super) fn toward_frustum<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit
     let mean = Vec3::from_array(mean).normalize_or_zero();
     let m = [V::splat(mean.x), V::splat(mean.y), V::splat(mean.z)];
     let mut spread = zero;
-    for p in set.iter().map(|&j| &tile.packets[j]).filter(|p| p.valid.any()) {
+    for p in tile.packets[set].iter().filter(|p| p.valid.any()) {
         let (d, _, _) = toward_segment(p, &tw);
         let c = dot3(&d, &m);
         let cross = [d[1] * m[2] - m[1] * d[2], d[2] * m[0] - m[2] * d[0], d[0] * m[1] - m[0] * d[1]];
@@ -335,10 +332,12 @@ mod tests {
         fn run<V: Vf32>(self) -> Self::Output {
             let height = self.rays.len() / self.width;
             let tile = PacketTile::<V>::new(self.rays, self.width, height);
-            let all: Vec<usize> = (0..tile.packets.len()).collect();
             let rays = RayRect { rays: self.rays, width: self.width, x: 0..self.width, y: 0..height };
-            let packets =
-                toward_frustum(&Bundled { tile: &tile, set: &all, rays: rays.clone() }, self.light, self.limit);
+            let packets = toward_frustum(
+                &Bundled { tile: &tile, set: 0..tile.packets.len(), rays: rays.clone() },
+                self.light,
+                self.limit,
+            );
             let scalar = toward_segments(rays, self.light, self.limit).and_then(|(segs, slack)| {
                 let mut f = Frustum::bounding(self.light, segs)?;
                 widen_toward(&mut f.t_max, &mut f.origin_slack, self.light, slack);

@@ -13,6 +13,8 @@ mod scratch;
 pub use proxy::Proxy;
 pub(crate) use scratch::TileScratch;
 
+use std::ops::Range;
+
 use glam::Vec3;
 use raylab_simd::{Backend, VMask, Vf32};
 use serde::Serialize;
@@ -226,7 +228,7 @@ impl<'a> Tracer<'a> {
         stats: &mut TraversalStats,
     ) {
         let method = self.options.method;
-        let TileScratch { all, stack, tile, rays: grid, .. } = scratch;
+        let TileScratch { stack, tile, rays: grid, .. } = scratch;
         if let Some(toward) = toward.filter(|_| method.is_bundled() && rays.len() >= EDGE_BUNDLE_MIN_RAYS) {
             // The rays in packet order: a tile one packet wide whose packets hold consecutive rays.
             let pw = PacketTile::<V>::PACKET_W;
@@ -235,10 +237,12 @@ impl<'a> Tracer<'a> {
             grid.extend(rays.iter().copied().map(Some));
             grid.resize(pw * height, None);
             tile.refill(grid, pw, height);
-            all.clear();
-            all.extend(0..tile.packets.len());
             let (tile, grid) = (&*tile, &grid[..]);
-            let whole = Bundled { tile, set: all, rays: RayRect { rays: grid, width: pw, x: 0..pw, y: 0..height } };
+            let whole = Bundled {
+                tile,
+                set: 0..tile.packets.len(),
+                rays: RayRect { rays: grid, width: pw, x: 0..pw, y: 0..height },
+            };
             let (limit, cull) = (self.options.shadow_spread_limit, self.options.cull);
             // `if let` rather than `Option::map` closures, whose vector code may stay out of line (see `map3`).
             if matches!(method, Method::Cone | Method::MftCone) {
@@ -353,30 +357,28 @@ impl<'a> Tracer<'a> {
         out: &mut [Option<Hit>],
         stats: &mut TraversalStats,
     ) {
-        let TileScratch { all, stack, tile, .. } = scratch;
+        let TileScratch { stack, tile, .. } = scratch;
         tile.refill(rays, width, height);
-        all.clear();
-        all.extend(0..tile.packets.len());
-        let all = &all[..];
+        let all = 0..tile.packets.len();
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         // Tiles no bundle covers are traced as packets (after the match, so the packet kernel is inlined once).
         let cull = self.options.cull;
         // The rays' common origin, found once for the tile: every bundle of its packets starts there.
-        let shared = if self.options.method.is_bundled() { common_origin(tile, all) } else { None };
+        let shared = if self.options.method.is_bundled() { common_origin(&tile.packets) } else { None };
         if cull && let Some(origin) = shared {
             tile.share_origin(origin);
         }
         let bundled = match (self.options.method, shared) {
             (Method::Frustum, Some(o)) => {
-                let f = frustum_from(o, tile, all);
+                let f = frustum_from(o, tile, all.clone());
                 if let Some(f) = &f {
                     self.tree.intersect_frustum(f, tile, all, cull, stats);
                 }
                 f.is_some()
             }
             (Method::Cone, Some(o)) => {
-                let c = cone_from(o, tile, all);
+                let c = cone_from(o, tile, all.clone());
                 if let Some(c) = &c {
                     self.tree.intersect_frustum(c, tile, all, cull, stats);
                 }
@@ -439,15 +441,13 @@ impl<'a> Tracer<'a> {
         out: &mut [bool],
         stats: &mut TraversalStats,
     ) {
-        let TileScratch { all, blocked, stack, tile, .. } = scratch;
+        let TileScratch { blocked, stack, tile, .. } = scratch;
         tile.refill(rays, width, height);
         blocked.clear();
         blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
-        all.clear();
-        all.extend(0..tile.packets.len());
-        let all = &all[..];
+        let all = 0..tile.packets.len();
         // The rays' common origin when they have one (camera rays), found once for the tile.
-        let shared = if self.options.method.is_bundled() { common_origin(tile, all) } else { None };
+        let shared = if self.options.method.is_bundled() { common_origin(&tile.packets) } else { None };
         if self.options.cull
             && let Some(origin) = shared
         {
@@ -457,39 +457,39 @@ impl<'a> Tracer<'a> {
         stats.rays += tile.packets.iter().map(|p| p.valid.bits().count_ones() as u64).sum::<u64>();
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         // Packets no bundle covers are traced as packets afterwards: all of them, or the quadrants' rest.
-        let mut rest: Option<Vec<usize>> = None;
-        let mut all_left = false;
+        let mut rest: [Range<usize>; 4] = Default::default();
         match self.options.method {
-            Method::Frustum => match self.whole(tile, all, rays, toward, shared, frustum_from, toward_frustum) {
-                Some(f) => self.tree.occluded_frustum(&f, tile, all, self.options.cull, blocked, stats),
-                None => all_left = true,
-            },
-            Method::Cone => match self.whole(tile, all, rays, toward, shared, cone_from, toward_cone) {
+            Method::Frustum => {
+                match self.whole(tile, all.clone(), rays, toward, shared, frustum_from, toward_frustum) {
+                    Some(f) => self.tree.occluded_frustum(&f, tile, all, self.options.cull, blocked, stats),
+                    None => rest[0] = all,
+                }
+            }
+            Method::Cone => match self.whole(tile, all.clone(), rays, toward, shared, cone_from, toward_cone) {
                 Some(c) => self.tree.occluded_frustum(&c, tile, all, self.options.cull, blocked, stats),
-                None => all_left = true,
+                None => rest[0] = all,
             },
             Method::Mft => match self.quadrants(tile, rays, toward, shared, frustum_from, toward_frustum) {
                 Some((b, sets, left)) => {
                     if let Some(f4) = Frustum4::new(b) {
                         self.tree.occluded_mft(&f4, tile, &sets, self.options.cull, blocked, stats);
                     }
-                    rest = Some(left);
+                    rest = left;
                 }
-                None => all_left = true,
+                None => rest[0] = all,
             },
             Method::MftCone => match self.quadrants(tile, rays, toward, shared, cone_from, toward_cone) {
                 Some((b, sets, left)) => {
                     if let Some(c4) = Frustum4::new(b) {
                         self.tree.occluded_mft(&c4, tile, &sets, self.options.cull, blocked, stats);
                     }
-                    rest = Some(left);
+                    rest = left;
                 }
-                None => all_left = true,
+                None => rest[0] = all,
             },
-            _ => all_left = true,
+            _ => rest[0] = all,
         }
-        let left = if all_left { all } else { rest.as_deref().unwrap_or_default() };
-        for &j in left {
+        for j in rest.into_iter().flatten() {
             blocked[j] = self.tree.occluded_packet(&tile.packets[j], stack, stats);
         }
         for (j, b) in blocked.iter().enumerate() {

@@ -93,19 +93,17 @@ impl Tracer<'_> {
         out: &mut [bool],
         stats: &mut TraversalStats,
     ) {
-        let TileScratch { all, blocked, tile, .. } = scratch;
+        let TileScratch { blocked, tile, .. } = scratch;
         tile.refill(rays, width, height);
         let tile = &*tile;
-        // Plain loops: vector code must be inlined into the SIMD entry point (see `map3`).
-        all.clear();
-        for (j, p) in tile.packets.iter().enumerate() {
+        // A plain loop: vector code must be inlined into the SIMD entry point (see `map3`).
+        for p in &tile.packets {
             let bits = p.valid.bits();
-            if bits != 0 {
-                all.push(j);
-                stats.rays += bits.count_ones() as u64;
-            }
+            stats.rays += bits.count_ones() as u64;
+            stats.packets += (bits != 0) as u64;
         }
-        stats.packets += all.len() as u64;
+        // Every packet walks; those without a valid ray are never open at a leaf.
+        let all = 0..tile.packets.len();
         blocked.clear();
         blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
         let (tree, cull) = (self.tree, self.options.cull);

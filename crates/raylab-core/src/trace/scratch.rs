@@ -16,8 +16,6 @@ use crate::ray::Ray;
 /// them anew (cut anew, a 16-sample tile's packets cost two thirds as much as its proxy walk;
 /// docs/BENCHMARKS.md, shading readings).
 pub(crate) struct TileScratch<V: Vf32> {
-    /// Indices of the packets that take part in the walk.
-    pub all: Vec<usize>,
     /// Per packet, its blocked lanes.
     pub blocked: Vec<V::Mask>,
     /// The stack of packets traced alone.
@@ -30,13 +28,7 @@ pub(crate) struct TileScratch<V: Vf32> {
 
 impl<V: Vf32> Default for TileScratch<V> {
     fn default() -> Self {
-        Self {
-            all: Vec::new(),
-            blocked: Vec::new(),
-            stack: PacketStack::default(),
-            tile: PacketTile::empty(),
-            rays: Vec::new(),
-        }
+        Self { blocked: Vec::new(), stack: PacketStack::default(), tile: PacketTile::empty(), rays: Vec::new() }
     }
 }
 
