@@ -28,7 +28,7 @@ use crate::scene::{Camera, PointLight, PrimaryGrid, Scene};
 use crate::shadow::Shadows;
 use crate::stats::TraversalStats;
 use crate::trace::{TraceOptions, Tracer};
-use shade::to_display;
+use shade::to_display_rgba;
 
 /// Options of one rendered frame.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -90,15 +90,32 @@ pub struct Frame {
     pub range: Option<(f32, f32)>,
 }
 
-/// One pixel as a tile leaves it: its index, its colour, and the value scalar views map to colour.
-type PixelOut = (u32, [u8; 4], f32);
-
-/// A finished tile.
+/// A finished tile: where it lies in the image, its pixels row by row (`width` wide), and for the scalar views
+/// each pixel's value (the hit distance for depth, the work for heat maps) in the same layout.
 #[derive(Default)]
 struct TileOut {
-    pixels: Vec<PixelOut>,
+    x0: u32,
+    y0: u32,
+    width: u32,
+    rgba: Vec<[u8; 4]>,
+    values: Vec<f32>,
     stats: TraversalStats,
     stages: StageTimes,
+}
+
+impl TileOut {
+    /// An empty `tw x th` tile at `(x0, y0)`: black pixels, and infinite values (misses) for a scalar `view`.
+    fn new((x0, y0): (u32, u32), (tw, th): (u32, u32), view: FrameView) -> Self {
+        let n = (tw * th) as usize;
+        let values = if view.is_scalar() { vec![f32::INFINITY; n] } else { Vec::new() };
+        Self { x0, y0, width: tw, rgba: vec![[0, 0, 0, 255]; n], values, ..Self::default() }
+    }
+
+    /// The place of image pixel `(x, y)`, which lies in the tile, in the tile's buffers.
+    #[inline]
+    fn index(&self, (x, y): (u32, u32)) -> usize {
+        ((y - self.y0) * self.width + (x - self.x0)) as usize
+    }
 }
 
 /// Renders `scene` from `camera` lit by `light`, tracing primary, secondary and shadow rays tile by tile with
@@ -135,18 +152,29 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
 
     let mut rgba = vec![[0, 0, 0, 255]; (w * h) as usize];
     let range = settings.view.is_scalar().then(|| value_range(&done, settings));
+    let scalar_color = |v: f32| match (settings.view, range) {
+        (FrameView::Depth, Some((near, far))) => depth_color(v, near, far),
+        (_, Some((_, hot))) => heat_color(if hot > 0.0 { v / hot } else { 0.0 }),
+        _ => [0, 0, 0, 255],
+    };
     // The tiles are put in place band by band in parallel: a band of `tile` rows holds exactly one row of
-    // tiles, which arrive in row-major order. Done serially, this copy was a twentieth of a 1280x720 frame.
-    let band = w as usize * tile as usize;
-    let tiles_across = w.div_ceil(tile) as usize;
-    rgba.par_chunks_mut(band).zip(done.par_chunks(tiles_across)).enumerate().for_each(|(k, (out, row))| {
-        let start = k * band;
-        for (i, c, v) in row.iter().flat_map(|t| &t.pixels) {
-            out[*i as usize - start] = match (settings.view, range) {
-                (FrameView::Depth, Some((near, far))) => depth_color(*v, near, far),
-                (_, Some((_, hot))) => heat_color(if hot > 0.0 { v / hot } else { 0.0 }),
-                _ => *c,
-            };
+    // tiles, which arrive in row-major order, and each tile row is one copy.
+    let (width, tile) = (w as usize, tile as usize);
+    rgba.par_chunks_mut(width * tile).zip(done.par_chunks(w.div_ceil(tile as u32) as usize)).for_each(|(band, row)| {
+        for t in row {
+            let (x0, tw) = (t.x0 as usize, t.width as usize);
+            let dst = band.chunks_mut(width).map(|line| &mut line[x0..x0 + tw]);
+            if range.is_some() {
+                for (line, values) in dst.zip(t.values.chunks(tw)) {
+                    for (c, &v) in line.iter_mut().zip(values) {
+                        *c = scalar_color(v);
+                    }
+                }
+            } else {
+                for (line, src) in dst.zip(t.rgba.chunks(tw)) {
+                    line.copy_from_slice(src);
+                }
+            }
         }
     });
     let mut stats = TraversalStats::default();
@@ -167,7 +195,7 @@ pub fn surface_epsilon(scene: &Scene) -> f32 {
 /// The ends of a scalar view's colour scale: nearest and farthest hit for depth, zero and the largest (or the
 /// fixed) count for heat maps.
 fn value_range(tiles: &[TileOut], settings: &RenderSettings) -> (f32, f32) {
-    let values = || tiles.iter().flat_map(|t| t.pixels.iter().map(|p| p.2)).filter(|v| v.is_finite());
+    let values = || tiles.iter().flat_map(|t| t.values.iter().copied()).filter(|v| v.is_finite());
     if settings.view == FrameView::Depth {
         let near = values().fold(f32::INFINITY, f32::min);
         let far = values().fold(f32::NEG_INFINITY, f32::max);
@@ -250,9 +278,9 @@ impl TileContext<'_> {
     /// Renders the `tw x th` tile at `(x0, y0)`. Heat maps trace it unit by unit so that each unit's counters
     /// can be shared among its own pixels; the units are exactly the pieces the method traces anyway.
     fn tile(&self, x0: u32, y0: u32, tw: u32, th: u32, scratch: &mut Scratch) -> TileOut {
-        let mut out = TileOut { pixels: Vec::with_capacity((tw * th) as usize), ..TileOut::default() };
-        scratch.shadow.start_tile();
         let view = self.settings.view;
+        let mut out = TileOut::new((x0, y0), (tw, th), view);
+        scratch.shadow.start_tile();
         if !view.is_heat_map() {
             // A partial tile at the image's edge keeps the whole tile's order.
             let offsets = self.offsets.iter().copied().filter(|&(dx, dy)| dx < tw && dy < th);
@@ -262,7 +290,6 @@ impl TileContext<'_> {
         let (uw, uh) = unit_size(&self.tracer.options, self.tile);
         for uy in (0..th).step_by(uh as usize) {
             for ux in (0..tw).step_by(uw as usize) {
-                let start = out.pixels.len();
                 let before = out.stats;
                 let (bw, bh) = (uw.min(tw - ux), uh.min(th - uy));
                 let rows = (0..bh).flat_map(|dy| (0..bw).map(move |dx| (dx, dy)));
@@ -272,9 +299,9 @@ impl TileContext<'_> {
                 } else {
                     out.stats.isect_tests - before.isect_tests
                 };
-                let share = work as f32 / (out.pixels.len() - start).max(1) as f32;
-                for p in &mut out.pixels[start..] {
-                    p.2 = share;
+                let share = work as f32 / (bw * bh) as f32;
+                for line in out.values.chunks_mut(tw as usize).skip(uy as usize).take(bh as usize) {
+                    line[ux as usize..(ux + bw) as usize].fill(share);
                 }
             }
         }
@@ -282,7 +309,7 @@ impl TileContext<'_> {
     }
 
     /// Traces and shades the block of `(width, height)` pixels at `(x0, y0)`, its pixels visited at `offsets`
-    /// (row by row when `rows`, else as one line in the given order), appending them to `out`.
+    /// (row by row when `rows`, else as one line in the given order), writing them into the tile `out`.
     fn block(
         &self,
         (x0, y0): (u32, u32),
@@ -317,18 +344,30 @@ impl TileContext<'_> {
             }
         };
         let t = Instant::now();
-        out.pixels.extend(sc.pixels.iter().enumerate().map(|(i, &(x, y))| {
-            let index = y * self.width + x;
-            let (Some(r), Some(hit)) = (&sc.rays[i], &sc.hits[i]) else {
-                return (index, [0, 0, 0, 255], f32::INFINITY);
-            };
-            let c = match settings.view {
-                FrameView::Normals => shade::facing_normal(scene, r, hit) * 0.5 + Vec3::splat(0.5),
-                FrameView::Depth => Vec3::ZERO,
-                _ => colors[i],
-            };
-            (index, [to_display(c.x), to_display(c.y), to_display(c.z), 255], hit.t)
-        }));
+        let hits = sc.pixels.iter().zip(&sc.rays).zip(&sc.hits).enumerate().filter_map(|(i, ((&p, r), h))| {
+            let (Some(r), Some(h)) = (r, h) else { return None };
+            Some((i, p, r, h))
+        });
+        match settings.view {
+            FrameView::Normals => {
+                for (_, p, r, h) in hits {
+                    let k = out.index(p);
+                    out.rgba[k] = to_display_rgba(shade::facing_normal(scene, r, h) * 0.5 + Vec3::splat(0.5));
+                }
+            }
+            FrameView::Depth => {
+                for (_, p, _, h) in hits {
+                    let k = out.index(p);
+                    out.values[k] = h.t;
+                }
+            }
+            _ => {
+                for (i, p, _, _) in hits {
+                    let k = out.index(p);
+                    out.rgba[k] = to_display_rgba(colors[i]);
+                }
+            }
+        }
         out.stages.shading += t.elapsed().as_secs_f64();
     }
 }

@@ -199,15 +199,15 @@ pub fn normal_mapped(scene: &Scene, tri: usize, n: Vec3, texel: Vec3) -> Vec3 {
 /// much of it mispredicted exits).
 #[inline]
 pub fn to_display(v: f32) -> u8 {
-    if v.is_nan() || v <= 0.0 {
-        return 0;
-    }
-    if v >= 1.0 {
-        return 255;
-    }
+    DISPLAY.byte(v)
+}
+
+/// An opaque display pixel of linear colour `c`: [`to_display`] of each channel, with the table looked up
+/// once.
+#[inline]
+pub fn to_display_rgba(c: Vec3) -> [u8; 4] {
     let table = &*DISPLAY;
-    let start = table.bucket_start[DisplayTable::bucket(v)];
-    start + u8::from(v >= table.steps[start as usize])
+    [table.byte(c.x), table.byte(c.y), table.byte(c.z), 255]
 }
 
 /// The display formula itself, which [`DisplayTable`] is derived from.
@@ -229,6 +229,16 @@ impl DisplayTable {
     /// at the top (1 / (255 / 2.2) of the value, about 0.9%), so no bucket holds two steps.
     const SHIFT: u32 = 16;
 
+    /// [`gamma_byte`] of `v`, read from the table.
+    #[inline(always)]
+    fn byte(&self, v: f32) -> u8 {
+        // Clamped to [0, 1] with NaN and -0 going to +0 (a select, no branch): 0 and 1 have buckets too, and
+        // their bytes are the table's ends.
+        let v = if v > 0.0 { v.min(1.0) } else { 0.0 };
+        let start = self.bucket_start[Self::bucket(v)];
+        start + u8::from(v >= self.steps[start as usize])
+    }
+
     /// The bucket of a value in `(0, 1)`: its bit pattern's high bits, logarithmic in the value (positive
     /// floats order like their bit patterns).
     #[inline(always)]
@@ -249,7 +259,7 @@ impl DisplayTable {
             }
             f32::from_bits(lo)
         });
-        let buckets = Self::bucket(1.0);
+        let buckets = Self::bucket(1.0) + 1;
         let bucket_start = (0..buckets).map(|b| gamma_byte(f32::from_bits((b as u32) << Self::SHIFT))).collect();
         Self { steps, bucket_start }
     }
