@@ -204,7 +204,7 @@ pub fn to_display(v: f32) -> u8 {
 
 /// An opaque display pixel of linear colour `c`: [`to_display`] of each channel, with the table looked up
 /// once.
-#[inline]
+#[inline(always)]
 pub fn to_display_rgba(c: Vec3) -> [u8; 4] {
     let table = &*DISPLAY;
     [table.byte(c.x), table.byte(c.y), table.byte(c.z), 255]
