@@ -96,7 +96,7 @@ impl F32x4 {
     fn reduce(self, identity: f32, op: impl Fn(__m128, __m128) -> __m128) -> f32 {
         sse!({
             let ordered = _mm_cmpord_ps(self.0, self.0);
-            let v = _mm_or_ps(_mm_and_ps(ordered, self.0), _mm_andnot_ps(ordered, _mm_set1_ps(identity)));
+            let v = Self::select(M32x4(ordered), self, Self::splat(identity)).0;
             let m = op(v, _mm_movehl_ps(v, v));
             let m = op(m, _mm_shuffle_ps::<0b01>(m, m));
             if _mm_movemask_ps(ordered) == 0 { f32::NAN } else { _mm_cvtss_f32(m) }
