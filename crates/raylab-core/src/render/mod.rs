@@ -159,8 +159,9 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
     };
     // The tiles are put in place band by band in parallel: a band of `tile` rows holds exactly one row of
     // tiles, which arrive in row-major order, and each tile row is one copy.
+    let tiles_across = w.div_ceil(tile) as usize;
     let (width, tile) = (w as usize, tile as usize);
-    rgba.par_chunks_mut(width * tile).zip(done.par_chunks(w.div_ceil(tile as u32) as usize)).for_each(|(band, row)| {
+    rgba.par_chunks_mut(width * tile).zip(done.par_chunks(tiles_across)).for_each(|(band, row)| {
         for t in row {
             let (x0, tw) = (t.x0 as usize, t.width as usize);
             let dst = band.chunks_mut(width).map(|line| &mut line[x0..x0 + tw]);
