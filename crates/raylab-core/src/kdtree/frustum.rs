@@ -252,6 +252,11 @@ pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
 /// What a frustum walk does at a leaf. A trait rather than a closure so that it is always inlined into the
 /// walk, and so compiled with the kernel's target features (see [`raylab_simd::Kernel`]).
 pub(super) trait FrustumLeaf {
+    /// Whether the walk visits the child on the far side of each split from the origin first. Any-hit
+    /// walks do: their bundles start at the light, and the blockers of a segment lie mostly near its
+    /// surface end, so walking from that end finishes packets sooner (Sponza's shadow rays, MFT 16x16:
+    /// 9% fewer triangle tests, 6.5% fewer instructions; docs/BENCHMARKS.md).
+    const FAR_FIRST: bool = false;
     /// Tests `leaf`; returns the distance beyond which no ray needs more leaves, and whether the walk can stop.
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool);
 }
@@ -286,6 +291,8 @@ struct BlockedLeaves<'a, V: Vf32> {
 }
 
 impl<V: Vf32> FrustumLeaf for BlockedLeaves<'_, V> {
+    const FAR_FIRST: bool = true;
+
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
         let batch = &mut BatchBits::<1>::default();
@@ -353,9 +360,10 @@ impl KdTree {
         self.traverse_frustum(f, stats, &mut BlockedLeaves { tile, set, cull, blocked, open });
     }
 
-    /// Walks the leaves the frustum overlaps, roughly front to back, handing each to `leaf`.
+    /// Walks the leaves the frustum overlaps, roughly front to back (back to front where `L::FAR_FIRST`),
+    /// handing each to `leaf`.
     #[inline(always)]
-    pub(super) fn traverse_frustum<B: Bundle>(&self, f: &B, stats: &mut TraversalStats, leaf: &mut impl FrustumLeaf) {
+    pub(super) fn traverse_frustum<B: Bundle, L: FrustumLeaf>(&self, f: &B, stats: &mut TraversalStats, leaf: &mut L) {
         if self.triangles().is_empty() {
             return;
         }
@@ -376,6 +384,10 @@ impl KdTree {
                     node = front ^ 1;
                 } else if lo > far * (1.0 + SPLIT_SLACK) {
                     node = front;
+                } else if L::FAR_FIRST {
+                    stack[sp] = Entry { node: front as u32, near, far: hi.min(far) };
+                    sp += 1;
+                    (node, near) = (front ^ 1, lo.max(near));
                 } else {
                     stack[sp] = Entry { node: (front ^ 1) as u32, near: lo.max(near), far };
                     sp += 1;

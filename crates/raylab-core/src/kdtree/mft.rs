@@ -94,6 +94,8 @@ impl<V: Vf32> Frustum4<V> {
 
 /// What an MFT walk does at a leaf (a trait rather than a closure, like `frustum::FrustumLeaf`).
 trait MftLeaf<V: Vf32> {
+    /// Whether the walk visits the far child of each split first (see `frustum::FrustumLeaf::FAR_FIRST`).
+    const FAR_FIRST: bool = false;
     /// Tests `leaf` for the frustum lanes in `active` (bits), whose intervals start at `near`; returns each
     /// lane's distance limit and the lanes that are finished.
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32);
@@ -135,6 +137,8 @@ struct BlockedLeaves<'a, V: Vf32> {
 }
 
 impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
+    const FAR_FIRST: bool = true;
+
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32) {
         let batch = &mut BatchBits::<4>::default();
@@ -207,9 +211,10 @@ impl KdTree {
         self.traverse_mft(f, stats, &mut BlockedLeaves { tile, sets, cull, blocked, open, done: 0 });
     }
 
-    /// Walks the leaves the four frustums overlap, handing each to `leaf`.
+    /// Walks the leaves the four frustums overlap, handing each to `leaf`: nearest first from the shared
+    /// origin, or farthest first where `L::FAR_FIRST`.
     #[inline(always)]
-    fn traverse_mft<V: Vf32>(&self, f: &Frustum4<V>, stats: &mut TraversalStats, leaf: &mut impl MftLeaf<V>) {
+    fn traverse_mft<V: Vf32, L: MftLeaf<V>>(&self, f: &Frustum4<V>, stats: &mut TraversalStats, leaf: &mut L) {
         if self.triangles().is_empty() || f.valid.none() {
             return;
         }
@@ -238,6 +243,16 @@ impl KdTree {
                 let b_active = active & !front_only;
                 let (f_far, b_near) = (hi.min(far), lo.max(near));
                 if f_active.none() {
+                    (node, near, active) = (front ^ 1, b_near, b_active);
+                    continue;
+                }
+                if L::FAR_FIRST {
+                    if b_active.none() {
+                        (node, far, active) = (front, f_far, f_active);
+                        continue;
+                    }
+                    stack[sp] = Entry { node: front as u32, near, far: f_far, active: f_active };
+                    sp += 1;
                     (node, near, active) = (front ^ 1, b_near, b_active);
                     continue;
                 }
