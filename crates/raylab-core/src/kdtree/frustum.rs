@@ -252,10 +252,8 @@ pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
 /// What a frustum walk does at a leaf. A trait rather than a closure so that it is always inlined into the
 /// walk, and so compiled with the kernel's target features (see [`raylab_simd::Kernel`]).
 pub(super) trait FrustumLeaf {
-    /// Whether the walk visits the child on the far side of each split from the origin first. Any-hit
-    /// walks do: their bundles start at the light, and the blockers of a segment lie mostly near its
-    /// surface end, so walking from that end finishes packets sooner (Sponza's shadow rays, MFT 16x16:
-    /// 9% fewer triangle tests, 6.5% fewer instructions; docs/BENCHMARKS.md).
+    /// Whether the walk visits the child on the far side of each split from the origin first: any-hit walks
+    /// of bundles built from the light toward the segments' surface ends ([`KdTree::occluded_frustum`]).
     const FAR_FIRST: bool = false;
     /// Tests `leaf`; returns the distance beyond which no ray needs more leaves, and whether the walk can stop.
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool);
@@ -280,8 +278,9 @@ impl<V: Vf32> FrustumLeaf for ClosestLeaves<'_, V> {
     }
 }
 
-/// Occlusion of packets `set`: the walk stops once every lane is blocked.
-struct BlockedLeaves<'a, V: Vf32> {
+/// Occlusion of packets `set`: the walk stops once every lane is blocked. `FAR` sets
+/// [`FrustumLeaf::FAR_FIRST`].
+struct BlockedLeaves<'a, V: Vf32, const FAR: bool> {
     tile: &'a PacketTile<V>,
     set: ChunkSet,
     cull: bool,
@@ -290,8 +289,8 @@ struct BlockedLeaves<'a, V: Vf32> {
     open: usize,
 }
 
-impl<V: Vf32> FrustumLeaf for BlockedLeaves<'_, V> {
-    const FAR_FIRST: bool = true;
+impl<V: Vf32, const FAR: bool> FrustumLeaf for BlockedLeaves<'_, V, FAR> {
+    const FAR_FIRST: bool = FAR;
 
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, stats: &mut TraversalStats) -> (f32, bool) {
@@ -344,7 +343,12 @@ impl KdTree {
     }
 
     /// Marks in `blocked` the lanes of packets `set` that something blocks. The frustum `f` must bound the
-    /// rays' segments (it may be built from the other end of the segments, e.g. from a light).
+    /// rays' segments; it may be built from the other end of the segments, e.g. from a light, and then
+    /// `far_first` walks the far child of each split first: the blockers of a shadow segment lie mostly
+    /// near its surface end, so starting there finishes packets sooner (Sponza's hard shadows, MFT 16x16:
+    /// 9% fewer triangle tests, 6.5% fewer instructions; docs/BENCHMARKS.md). From the surface end (the
+    /// bundles of a point's light samples) the near child comes first.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn occluded_frustum<B: Bundle, V: Vf32>(
         &self,
@@ -352,12 +356,17 @@ impl KdTree {
         tile: &PacketTile<V>,
         set: Range<usize>,
         cull: bool,
+        far_first: bool,
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
         let open = open_packets(tile, set.clone(), blocked);
         let set = ChunkSet::new(set);
-        self.traverse_frustum(f, stats, &mut BlockedLeaves { tile, set, cull, blocked, open });
+        if far_first {
+            self.traverse_frustum(f, stats, &mut BlockedLeaves::<V, true> { tile, set, cull, blocked, open });
+        } else {
+            self.traverse_frustum(f, stats, &mut BlockedLeaves::<V, false> { tile, set, cull, blocked, open });
+        }
     }
 
     /// Walks the leaves the frustum overlaps, roughly front to back (back to front where `L::FAR_FIRST`),

@@ -94,7 +94,7 @@ impl<V: Vf32> Frustum4<V> {
 
 /// What an MFT walk does at a leaf (a trait rather than a closure, like `frustum::FrustumLeaf`).
 trait MftLeaf<V: Vf32> {
-    /// Whether the walk visits the far child of each split first (see `frustum::FrustumLeaf::FAR_FIRST`).
+    /// Whether the walk visits the far child of each split first (see [`KdTree::occluded_mft`]).
     const FAR_FIRST: bool = false;
     /// Tests `leaf` for the frustum lanes in `active` (bits), whose intervals start at `near`; returns each
     /// lane's distance limit and the lanes that are finished.
@@ -125,8 +125,9 @@ impl<V: Vf32> MftLeaf<V> for ClosestLeaves<'_, V> {
     }
 }
 
-/// Occlusion: a frustum is finished once all its packets' lanes are blocked.
-struct BlockedLeaves<'a, V: Vf32> {
+/// Occlusion: a frustum is finished once all its packets' lanes are blocked. `FAR` sets
+/// [`MftLeaf::FAR_FIRST`].
+struct BlockedLeaves<'a, V: Vf32, const FAR: bool> {
     tile: &'a PacketTile<V>,
     sets: [ChunkSet; 4],
     cull: bool,
@@ -136,8 +137,8 @@ struct BlockedLeaves<'a, V: Vf32> {
     done: u32,
 }
 
-impl<V: Vf32> MftLeaf<V> for BlockedLeaves<'_, V> {
-    const FAR_FIRST: bool = true;
+impl<V: Vf32, const FAR: bool> MftLeaf<V> for BlockedLeaves<'_, V, FAR> {
+    const FAR_FIRST: bool = FAR;
 
     #[inline(always)]
     fn visit(&mut self, leaf: &Leaf, near: [f32; 4], active: u32, stats: &mut TraversalStats) -> (Q<V>, u32) {
@@ -189,7 +190,9 @@ impl KdTree {
     }
 
     /// Marks in `blocked` the lanes of `tile`'s packets that something blocks; `sets[i]` is the run of
-    /// packets that frustum lane `i` bounds.
+    /// packets that frustum lane `i` bounds. `far_first` walks the far child of each split first, for
+    /// frustums built from the segments' other end, as in [`KdTree::occluded_frustum`].
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn occluded_mft<V: Vf32>(
         &self,
@@ -197,6 +200,7 @@ impl KdTree {
         tile: &PacketTile<V>,
         sets: &[Range<usize>; 4],
         cull: bool,
+        far_first: bool,
         blocked: &mut [V::Mask],
         stats: &mut TraversalStats,
     ) {
@@ -208,7 +212,11 @@ impl KdTree {
             open_packets(tile, sets[3].clone(), blocked),
         ];
         let sets = chunk_sets(sets);
-        self.traverse_mft(f, stats, &mut BlockedLeaves { tile, sets, cull, blocked, open, done: 0 });
+        if far_first {
+            self.traverse_mft(f, stats, &mut BlockedLeaves::<V, true> { tile, sets, cull, blocked, open, done: 0 });
+        } else {
+            self.traverse_mft(f, stats, &mut BlockedLeaves::<V, false> { tile, sets, cull, blocked, open, done: 0 });
+        }
     }
 
     /// Walks the leaves the four frustums overlap, handing each to `leaf`: nearest first from the shared

@@ -458,21 +458,25 @@ impl<'a> Tracer<'a> {
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         // Packets no bundle covers are traced as packets afterwards: all of them, or the quadrants' rest.
         let mut rest: [Range<usize>; 4] = Default::default();
+        // A bundle from a shared origin starts where the rays do; any other was built from `toward`, the
+        // segments' far end, and walks far side first.
+        let far_first = shared.is_none();
+        let cull = self.options.cull;
         match self.options.method {
             Method::Frustum => {
                 match self.whole(tile, all.clone(), rays, toward, shared, frustum_from, toward_frustum) {
-                    Some(f) => self.tree.occluded_frustum(&f, tile, all, self.options.cull, blocked, stats),
+                    Some(f) => self.tree.occluded_frustum(&f, tile, all, cull, far_first, blocked, stats),
                     None => rest[0] = all,
                 }
             }
             Method::Cone => match self.whole(tile, all.clone(), rays, toward, shared, cone_from, toward_cone) {
-                Some(c) => self.tree.occluded_frustum(&c, tile, all, self.options.cull, blocked, stats),
+                Some(c) => self.tree.occluded_frustum(&c, tile, all, cull, far_first, blocked, stats),
                 None => rest[0] = all,
             },
             Method::Mft => match self.quadrants(tile, rays, toward, shared, frustum_from, toward_frustum) {
                 Some((b, sets, left)) => {
                     if let Some(f4) = Frustum4::new(b) {
-                        self.tree.occluded_mft(&f4, tile, &sets, self.options.cull, blocked, stats);
+                        self.tree.occluded_mft(&f4, tile, &sets, cull, far_first, blocked, stats);
                     }
                     rest = left;
                 }
@@ -481,7 +485,7 @@ impl<'a> Tracer<'a> {
             Method::MftCone => match self.quadrants(tile, rays, toward, shared, cone_from, toward_cone) {
                 Some((b, sets, left)) => {
                     if let Some(c4) = Frustum4::new(b) {
-                        self.tree.occluded_mft(&c4, tile, &sets, self.options.cull, blocked, stats);
+                        self.tree.occluded_mft(&c4, tile, &sets, cull, far_first, blocked, stats);
                     }
                     rest = left;
                 }

@@ -107,9 +107,10 @@ impl Tracer<'_> {
         blocked.clear();
         blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
         let (tree, cull) = (self.tree, self.options.cull);
+        // The rays start at the apex, by the blockers near their surface point: nearest leaves first.
         match proxy {
-            Proxy::Pyramid(f) => tree.occluded_frustum(f, tile, all, cull, blocked, stats),
-            Proxy::Cone(c) => tree.occluded_frustum(c, tile, all, cull, blocked, stats),
+            Proxy::Pyramid(f) => tree.occluded_frustum(f, tile, all, cull, false, blocked, stats),
+            Proxy::Cone(c) => tree.occluded_frustum(c, tile, all, cull, false, blocked, stats),
         }
         for (j, b) in blocked.iter().enumerate() {
             let bits = b.bits();
