@@ -75,6 +75,12 @@ impl<V: Vf32> Frustum4<V> {
         })
     }
 
+    /// The origin the four bundles share.
+    #[inline(always)]
+    pub fn origin(&self) -> glam::Vec3 {
+        self.origin
+    }
+
     /// Per lane, the range of distances at which the bundle crosses `coordinate k = split`: the scalar
     /// [`Bundle::crossing`] in every lane, with one branch on the side of the shared origin.
     #[inline(always)]
@@ -254,11 +260,7 @@ impl KdTree {
                     (node, near, active) = (front ^ 1, b_near, b_active);
                     continue;
                 }
-                if L::FAR_FIRST {
-                    if b_active.none() {
-                        (node, far, active) = (front, f_far, f_active);
-                        continue;
-                    }
+                if L::FAR_FIRST && b_active.any() {
                     stack[sp] = Entry { node: front as u32, near, far: f_far, active: f_active };
                     sp += 1;
                     (node, near, active) = (front ^ 1, b_near, b_active);

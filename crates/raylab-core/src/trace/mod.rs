@@ -458,25 +458,25 @@ impl<'a> Tracer<'a> {
         stats.packets += tile.packets.iter().filter(|p| p.valid.bits() != 0).count() as u64;
         // Packets no bundle covers are traced as packets afterwards: all of them, or the quadrants' rest.
         let mut rest: [Range<usize>; 4] = Default::default();
-        // A bundle from a shared origin starts where the rays do; any other was built from `toward`, the
-        // segments' far end, and walks far side first.
-        let far_first = shared.is_none();
+        // A bundle whose apex is not the rays' shared origin was built from `toward`, the segments' far end,
+        // and walks far side first.
+        let far_first = |apex: Vec3| Some(apex) != shared;
         let cull = self.options.cull;
         match self.options.method {
             Method::Frustum => {
                 match self.whole(tile, all.clone(), rays, toward, shared, frustum_from, toward_frustum) {
-                    Some(f) => self.tree.occluded_frustum(&f, tile, all, cull, far_first, blocked, stats),
+                    Some(f) => self.tree.occluded_frustum(&f, tile, all, cull, far_first(f.origin), blocked, stats),
                     None => rest[0] = all,
                 }
             }
             Method::Cone => match self.whole(tile, all.clone(), rays, toward, shared, cone_from, toward_cone) {
-                Some(c) => self.tree.occluded_frustum(&c, tile, all, cull, far_first, blocked, stats),
+                Some(c) => self.tree.occluded_frustum(&c, tile, all, cull, far_first(c.origin), blocked, stats),
                 None => rest[0] = all,
             },
             Method::Mft => match self.quadrants(tile, rays, toward, shared, frustum_from, toward_frustum) {
                 Some((b, sets, left)) => {
                     if let Some(f4) = Frustum4::new(b) {
-                        self.tree.occluded_mft(&f4, tile, &sets, cull, far_first, blocked, stats);
+                        self.tree.occluded_mft(&f4, tile, &sets, cull, far_first(f4.origin()), blocked, stats);
                     }
                     rest = left;
                 }
@@ -485,7 +485,7 @@ impl<'a> Tracer<'a> {
             Method::MftCone => match self.quadrants(tile, rays, toward, shared, cone_from, toward_cone) {
                 Some((b, sets, left)) => {
                     if let Some(c4) = Frustum4::new(b) {
-                        self.tree.occluded_mft(&c4, tile, &sets, cull, far_first, blocked, stats);
+                        self.tree.occluded_mft(&c4, tile, &sets, cull, far_first(c4.origin()), blocked, stats);
                     }
                     rest = left;
                 }
