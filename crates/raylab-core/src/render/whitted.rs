@@ -81,8 +81,12 @@ impl TileContext<'_> {
                 _ => Vec3::ZERO,
             })
             .collect();
+        // A scene whose materials spawn nothing (checking them is cheaper than scanning the layer) skips the
+        // scan of the layer's surfaces.
+        let spawns = |kind: MaterialKind| kind.reflects() || kind.refracts();
         let spawn = depth < self.settings.max_depth
-            && surfaces.iter().flatten().any(|s| s.material.kind.reflects() || s.material.kind.refracts());
+            && scene.materials.iter().any(|m| spawns(m.kind))
+            && surfaces.iter().flatten().any(|s| spawns(s.material.kind));
         let secondary = spawn.then(|| {
             let n = rays.len();
             let mut mixes = vec![Mix { local: 1.0, ..Mix::default() }; n];
