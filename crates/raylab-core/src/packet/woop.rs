@@ -39,14 +39,15 @@ fn rel_permuted<V: Vf32>(p: &RayPacket<V>, v: Vec3) -> (V, V, V) {
 /// [`crate::triangle::RayShear::intersect`]'s `f32` operations in its order.
 #[inline(always)]
 pub(crate) fn sheared_test<V: Vf32>(corners: [(V, V, V); 3], shear: [V; 3], tmin: V, tmax: V) -> Sheared<V> {
-    sheared_edges(corners, shear, tmin, tmax).finish(tmin, tmax)
+    edge_functions(corners, shear).distance(tmin, tmax).finish(tmin, tmax)
 }
 
-/// The first part of [`sheared_test`]: the edge functions and the scaled distance, which decide every lane
-/// but the few that the division's rounding moves out of `(tmin, tmax]`. A packet test whose lanes all miss
-/// here skips the division and what follows it.
+/// The first step of [`sheared_test`]: the three edge functions of the sheared triangle, which decide most
+/// lanes. A packet test whose lanes all pass outside an edge here (most tests at a leaf: docs/BENCHMARKS.md,
+/// session 51) skips the distance and the division; the tests of [`crate::tri4`] (one ray, four triangles)
+/// take them as they are, where stopping here saved nothing.
 #[inline(always)]
-fn sheared_edges<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3], tmin: V, tmax: V) -> Edges<V> {
+fn edge_functions<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3]) -> EdgeFunctions<V> {
     let [(a_x, a_y, a_z), (b_x, b_y, b_z), (c_x, c_y, c_z)] = corners;
     let ax = a_x - sx * a_z;
     let ay = a_y - sy * a_z;
@@ -61,16 +62,50 @@ fn sheared_edges<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3], tmin: V
     let exact_zero = u.eq(zero) | v.eq(zero) | w.eq(zero);
     let neg = u.lt(zero) | v.lt(zero) | w.lt(zero);
     let pos = u.gt(zero) | v.gt(zero) | w.gt(zero);
-    let det = u + v + w;
-    let t_scaled = u * (sz * a_z) + v * (sz * b_z) + w * (sz * c_z);
-    let abs_det = det.abs();
-    let t_signed = V::select(det.lt(zero), zero - t_scaled, t_scaled);
-    let inside = t_signed.gt(tmin * abs_det) & t_signed.le(tmax * abs_det * V::splat(SCALED_FAR_SLACK));
-    let maybe = !exact_zero & !(neg & pos) & !det.eq(zero) & inside;
-    Edges { maybe, exact_zero, det, t_scaled, v, w }
+    EdgeFunctions { u, v, w, z: [sz * a_z, sz * b_z, sz * c_z], exact_zero, one_side: !(neg & pos) }
 }
 
-/// What [`sheared_edges`] leaves for the division.
+/// The edge functions of [`edge_functions`] and what the distance needs of the corners.
+struct EdgeFunctions<V: Vf32> {
+    u: V,
+    v: V,
+    w: V,
+    /// The corners' sheared `z` (`S_z` times their `kz` component).
+    z: [V; 3],
+    /// Lanes with an edge function of exactly zero.
+    exact_zero: V::Mask,
+    /// Lanes whose edge functions do not take both signs: the ray passes inside the triangle's edges, or
+    /// meets an edge or a vertex.
+    one_side: V::Mask,
+}
+
+impl<V: Vf32> EdgeFunctions<V> {
+    /// The lanes that may still hit, as far as the edges tell: on one side of every edge, or with an edge
+    /// function of exactly zero (which the scalar test's double-precision fallback decides). A packet test
+    /// whose active lanes have none skips the distance.
+    #[inline(always)]
+    fn undecided(&self) -> V::Mask {
+        self.one_side | self.exact_zero
+    }
+
+    /// The second step of [`sheared_test`]: the scaled distance, which decides every lane but the few that
+    /// the division's rounding moves out of `(tmin, tmax]`. A packet test whose lanes all miss here skips
+    /// the division and what follows it.
+    #[inline(always)]
+    fn distance(self, tmin: V, tmax: V) -> Edges<V> {
+        let Self { u, v, w, z: [az, bz, cz], exact_zero, one_side } = self;
+        let zero = V::splat(0.0);
+        let det = u + v + w;
+        let t_scaled = u * az + v * bz + w * cz;
+        let abs_det = det.abs();
+        let t_signed = V::select(det.lt(zero), zero - t_scaled, t_scaled);
+        let inside = t_signed.gt(tmin * abs_det) & t_signed.le(tmax * abs_det * V::splat(SCALED_FAR_SLACK));
+        let maybe = !exact_zero & one_side & !det.eq(zero) & inside;
+        Edges { maybe, exact_zero, det, t_scaled, v, w }
+    }
+}
+
+/// What [`EdgeFunctions::distance`] leaves for the division.
 struct Edges<V: Vf32> {
     /// Lanes that hit unless the division's rounding puts `t` outside `(tmin, tmax]`.
     maybe: V::Mask,
@@ -115,6 +150,15 @@ struct LaneHits<V: Vf32> {
     v: V,
 }
 
+impl<V: Vf32> LaneHits<V> {
+    /// No lane hit (the distances are only read where a lane hits).
+    #[inline(always)]
+    fn none() -> Self {
+        let zero = V::splat(0.0);
+        LaneHits { mask: V::Mask::from_bits(0), t: zero, u: zero, v: zero }
+    }
+}
+
 #[inline(always)]
 fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
     // Corners relative to the origins, permuted into (kx, ky, kz) order: by indexing when every lane shares
@@ -123,12 +167,15 @@ fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) ->
         Some(k) => [rel_uniform(p, &tri[0], k), rel_uniform(p, &tri[1], k), rel_uniform(p, &tri[2], k)],
         None => [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])],
     };
-    let edges = sheared_edges(corners, p.shear, p.tmin, tmax);
+    let fns = edge_functions(corners, p.shear);
+    if (fns.undecided() & active).none() {
+        return LaneHits::none();
+    }
+    let edges = fns.distance(p.tmin, tmax);
     let exact_zero = edges.exact_zero & active;
     if ((edges.maybe | edges.exact_zero) & active).none() {
-        // Every lane misses: no division. The distances are only read where a lane hits.
-        let zero = V::splat(0.0);
-        return LaneHits { mask: V::Mask::from_bits(0), t: zero, u: zero, v: zero };
+        // Every lane misses: no division.
+        return LaneHits::none();
     }
     let lanes = edges.finish(p.tmin, tmax);
     let mut mask = lanes.hit & active;
