@@ -81,12 +81,8 @@ impl TileContext<'_> {
                 _ => Vec3::ZERO,
             })
             .collect();
-        // A scene whose materials spawn nothing (checking them is cheaper than scanning the layer) skips the
-        // scan of the layer's surfaces.
-        let spawns = |kind: MaterialKind| kind.reflects() || kind.refracts();
         let spawn = depth < self.settings.max_depth
-            && scene.materials.iter().any(|m| spawns(m.kind))
-            && surfaces.iter().flatten().any(|s| spawns(s.material.kind));
+            && surfaces.iter().flatten().any(|s| s.material.kind.reflects() || s.material.kind.refracts());
         let secondary = spawn.then(|| {
             let n = rays.len();
             let mut mixes = vec![Mix { local: 1.0, ..Mix::default() }; n];
