@@ -10,7 +10,7 @@ use super::partition::partition;
 use super::records::{RayRecord, SetBounds, TriRecord, row_lanes};
 use super::split::divide;
 use super::{DacrtParams, TopNode};
-use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
+use crate::packet::{PacketHits, PacketTester, RayPacket};
 use crate::ray::{Hit, hit_reach};
 use crate::stats::TraversalStats;
 use crate::triangle::TriangleSoup;
@@ -65,8 +65,9 @@ impl Answer for Closest<'_> {
         for group in rays.chunks_mut(V::LANES) {
             let p = packet::<V>(group);
             let mut hits = PacketHits::new(&p);
+            let tester = PacketTester::new(&p);
             for t in tris {
-                intersect_packet(&p, &mut hits, soup.get(t.id), t.id, p.valid);
+                tester.intersect(&mut hits, soup.get(t.id), t.id, p.valid);
             }
             let found = hits.to_hits();
             for (r, h) in group.iter_mut().zip(found.as_ref()) {
@@ -88,8 +89,9 @@ impl Answer for Closest<'_> {
 fn blocked<V: Vf32>(p: &RayPacket<V>, soup: &TriangleSoup, tris: &[TriRecord]) -> (u32, V::Array<u32>) {
     let mut open = p.valid;
     let mut first = V::array_from_fn(|_| u32::MAX);
+    let tester = PacketTester::new(p);
     for t in tris {
-        let hit = occlude_packet(p, soup.get(t.id), open);
+        let hit = tester.occlude(soup.get(t.id), open);
         if hit.any() {
             let bits = hit.bits();
             for (k, f) in first.as_mut().iter_mut().enumerate() {

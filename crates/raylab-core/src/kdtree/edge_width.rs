@@ -24,7 +24,7 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
 use crate::aabb::Aabb;
-use crate::packet::{BatchCull, Bundle, PacketTile, RayPacket, crossing_packet, map3, overlaps_box};
+use crate::packet::{BatchCull, Bundle, PacketTester, PacketTile, RayPacket, map3, overlaps_box};
 use crate::ray::Ray;
 use crate::shadow::{Crossing, EdgeWidth};
 use crate::stats::TraversalStats;
@@ -263,9 +263,10 @@ fn leaf_crossings<V: Vf32>(
     let tris = tree.triangles();
     let mut t = V::array_from_fn(|_| 0.0);
     let mut added = 0;
+    let tester = PacketTester::new(p);
     for &id in ids {
         let corners = tris.get(id);
-        let (hit, t_hit) = crossing_packet(p, corners, active);
+        let (hit, t_hit) = tester.crossing(corners, active);
         if hit.none() {
             continue;
         }

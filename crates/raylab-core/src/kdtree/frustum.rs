@@ -16,7 +16,7 @@ use super::mono::SPLIT_SLACK;
 use super::{KdNode, KdParams, KdTree};
 use crate::aabb::{Aabb, coord};
 use crate::packet::hit_reach_lanes;
-use crate::packet::{Bundle, PacketTile, intersect_packet, occlude_packet, overlaps_box};
+use crate::packet::{Bundle, PacketTester, PacketTile, overlaps_box};
 use crate::ray::hit_reach;
 use crate::stats::TraversalStats;
 
@@ -183,9 +183,10 @@ fn packet_intersect<V: Vf32>(
     }
     stats.packets_tested += 1;
     let mut packet_changed = false;
+    let tester = PacketTester::new(p);
     for &id in ids {
         stats.isect_tests += 1;
-        packet_changed |= intersect_packet(p, hits, tree.triangles().get(id), id, active).any();
+        packet_changed |= tester.intersect(hits, tree.triangles().get(id), id, active).any();
     }
     if packet_changed {
         tile.farthest_hit[j] = hit_reach(V::select(p.valid, hits.t, V::splat(f32::NEG_INFINITY)).reduce_max());
@@ -235,9 +236,10 @@ pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
                 }
             }
             stats.packets_tested += 1;
+            let tester = PacketTester::new(p);
             for &id in ids {
                 stats.isect_tests += 1;
-                blocked[j] = blocked[j] | occlude_packet(p, tree.triangles().get(id), open);
+                blocked[j] = blocked[j] | tester.occlude(tree.triangles().get(id), open);
                 open = open & !blocked[j];
                 if open.none() {
                     break;

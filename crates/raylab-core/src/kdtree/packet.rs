@@ -19,7 +19,7 @@ use raylab_simd::{VMask, Vf32};
 
 use super::mono::SPLIT_SLACK;
 use super::{KdNode, KdParams, KdTree};
-use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet, slab_interval};
+use crate::packet::{PacketHits, PacketTester, RayPacket, slab_interval};
 use crate::stats::TraversalStats;
 
 #[derive(Clone, Copy)]
@@ -76,9 +76,10 @@ struct ClosestHits<'a, V: Vf32> {
 impl<V: Vf32> PacketLeaf<V> for ClosestHits<'_, V> {
     #[inline(always)]
     fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask, _: V) -> (V, V::Mask) {
+        let tester = PacketTester::new(self.p);
         for &id in &self.tree.tri_ids()[ids] {
             self.tests += 1;
-            intersect_packet(self.p, self.hits, self.tree.triangles().get(id), id, active);
+            tester.intersect(self.hits, self.tree.triangles().get(id), id, active);
         }
         (crate::packet::hit_reach_lanes(self.hits.t), V::Mask::from_bits(0))
     }
@@ -96,12 +97,13 @@ impl<V: Vf32> PacketLeaf<V> for Blockers<'_, V> {
     #[inline(always)]
     fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask, _: V) -> (V, V::Mask) {
         let mut open = active & !self.blocked;
+        let tester = PacketTester::new(self.p);
         for &id in &self.tree.tri_ids()[ids] {
             if open.none() {
                 break;
             }
             self.tests += 1;
-            self.blocked = self.blocked | occlude_packet(self.p, self.tree.triangles().get(id), open);
+            self.blocked = self.blocked | tester.occlude(self.tree.triangles().get(id), open);
             open = open & !self.blocked;
         }
         (self.p.tmax, self.blocked)

@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 use super::Mbvh;
 use super::node::MbvhNode;
 use super::single::FAR_SLACK;
-use crate::packet::{PacketHits, RayPacket, intersect_packet, occlude_packet};
+use crate::packet::{PacketHits, PacketTester, RayPacket};
 use crate::ray::{Hit, Ray, hit_reach};
 use crate::stats::TraversalStats;
 use crate::tri4::{ShearGroups, ShearRecord, ShearX4};
@@ -596,9 +596,10 @@ impl Mbvh {
         let mut tests = 0;
         if shadow {
             let mut open = p.valid;
+            let tester = PacketTester::new(&p);
             for slot in tri_slots {
                 tests += 1;
-                open = open & !occlude_packet(&p, self.tris.get(slot as u32), open);
+                open = open & !tester.occlude(self.tris.get(slot as u32), open);
                 if open.none() {
                     break;
                 }
@@ -611,9 +612,10 @@ impl Mbvh {
             }
         } else {
             let mut hits = PacketHits::new(&p);
+            let tester = PacketTester::new(&p);
             for slot in tri_slots {
                 tests += 1;
-                intersect_packet(&p, &mut hits, self.tris.get(slot as u32), self.tri_ids[slot], p.valid);
+                tester.intersect(&mut hits, self.tris.get(slot as u32), self.tri_ids[slot], p.valid);
             }
             let found = hits.to_hits();
             for (k, &id) in group.iter().enumerate() {

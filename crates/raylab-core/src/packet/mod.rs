@@ -16,8 +16,8 @@ pub use batch_cull::BatchCull;
 pub use cone::Cone;
 pub use disc::Disc;
 pub use tile::{Bundle, Frustum, PacketTile, overlaps_box, packet_shape, slab_interval};
-pub(crate) use woop::{Sheared, crossing_packet, sheared_test};
-pub use woop::{intersect_packet, occlude_packet};
+pub use woop::{PacketTester, intersect_packet, occlude_packet};
+pub(crate) use woop::{Sheared, sheared_test};
 
 /// Most lanes a packet may have (16, for AVX-512).
 pub const MAX_LANES: usize = 16;

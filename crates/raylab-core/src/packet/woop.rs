@@ -17,12 +17,12 @@ fn pick<V: Vf32>(is: [V::Mask; 2], x: V, y: V, z: V) -> V {
     V::select(is[0], x, V::select(is[1], y, z))
 }
 
-/// Corner `v` relative to the packet's origins, components in `(kx, ky, kz)` order for every lane.
+/// Corner `v` relative to origins `org` (already in `(kx, ky, kz)` order), components in that order.
 #[inline(always)]
-fn rel_uniform<V: Vf32>(p: &RayPacket<V>, v: &Vec3, [kx, ky, kz]: [usize; 3]) -> (V, V, V) {
+fn rel_uniform<V: Vf32>(org: &[V; 3], v: &Vec3, [kx, ky, kz]: [usize; 3]) -> (V, V, V) {
     // Indexing the corner where it lies loads each component straight from the triangle, with no copy first.
     let v: &[f32; 3] = v.as_ref();
-    (V::splat(v[kx]) - p.org[kx], V::splat(v[ky]) - p.org[ky], V::splat(v[kz]) - p.org[kz])
+    (V::splat(v[kx]) - org[0], V::splat(v[ky]) - org[1], V::splat(v[kz]) - org[2])
 }
 
 /// Corner `v` relative to the packet's origins, permuted per lane into that lane's `(kx, ky, kz)` order.
@@ -159,54 +159,134 @@ impl<V: Vf32> LaneHits<V> {
     }
 }
 
-#[inline(always)]
-fn test<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
-    // Corners relative to the origins, permuted into (kx, ky, kz) order: by indexing when every lane shares
-    // the permutation, by per-lane selects otherwise. Both give each lane exactly `v[k] - o[k]`.
-    let corners = match p.uniform_axes {
-        Some(k) => [rel_uniform(p, &tri[0], k), rel_uniform(p, &tri[1], k), rel_uniform(p, &tri[2], k)],
-        None => [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])],
-    };
-    let fns = edge_functions(corners, p.shear);
-    if (fns.undecided() & active).none() {
-        return LaneHits::none();
-    }
-    let edges = fns.distance(p.tmin, tmax);
-    let exact_zero = edges.exact_zero & active;
-    if ((edges.maybe | edges.exact_zero) & active).none() {
-        // Every lane misses: no division.
-        return LaneHits::none();
-    }
-    let lanes = edges.finish(p.tmin, tmax);
-    let mut mask = lanes.hit & active;
-    let (mut t, mut bu, mut bv) = (lanes.t, lanes.u, lanes.v);
-    if exact_zero.any() {
-        // Rare: an edge function is exactly zero, and the paper recomputes it in double precision. Let the
-        // scalar test, which does exactly that, decide those lanes.
-        let bits = exact_zero.bits();
-        let (mut ta, mut ua, mut va) =
-            ([0.0f32; super::MAX_LANES], [0.0f32; super::MAX_LANES], [0.0f32; super::MAX_LANES]);
-        t.write_to(&mut ta[..V::LANES]);
-        bu.write_to(&mut ua[..V::LANES]);
-        bv.write_to(&mut va[..V::LANES]);
-        let mut hit_bits = mask.bits();
-        for i in (0..V::LANES).filter(|i| bits >> i & 1 == 1) {
-            let ray = p.ray(i);
-            if let Some(h) = crate::triangle::RayShear::new(&ray).intersect(tri, ray.tmin, tmax.lane(i)) {
-                (ta[i], ua[i], va[i]) = (h.t, h.u, h.v);
-                hit_bits |= 1 << i;
-            }
-        }
-        mask = V::Mask::from_bits(hit_bits);
-        t = V::from_slice(&ta[..V::LANES]);
-        bu = V::from_slice(&ua[..V::LANES]);
-        bv = V::from_slice(&va[..V::LANES]);
-    }
-    LaneHits { mask, t, u: bu, v: bv }
+/// A packet set up for a run of triangle tests (the triangles of a leaf): what the watertight test reads of
+/// the packet for every triangle, the origins in the lanes' shared `(kx, ky, kz)` order, is fetched once
+/// instead of once per triangle, with the permutation's indices known to be in range.
+#[derive(Clone, Copy)]
+pub struct PacketTester<'a, V: Vf32> {
+    p: &'a RayPacket<V>,
+    /// The lanes' shared `(kx, ky, kz)` and the origins in that order, when every lane has the same ones.
+    uniform: Option<([usize; 3], [V; 3])>,
 }
 
-/// Tests triangle `id` (corners `tri`) against the `active` lanes and keeps closer hits in `hits`, accepting
-/// `tmin < t <= hits.t` per lane as the scalar test does. Returns the lanes that hit it.
+impl<'a, V: Vf32> PacketTester<'a, V> {
+    /// Prepares packet `p`.
+    #[inline(always)]
+    pub fn new(p: &'a RayPacket<V>) -> Self {
+        let uniform = match p.uniform_axes {
+            Some([kx, ky, kz]) => {
+                // `min` tells the compiler what `from_lanes` guarantees, so the tests index without checks.
+                let k = [kx.min(2), ky.min(2), kz.min(2)];
+                Some((k, [p.org[k[0]], p.org[k[1]], p.org[k[2]]]))
+            }
+            None => None,
+        };
+        Self { p, uniform }
+    }
+
+    /// The packet.
+    #[inline(always)]
+    pub fn packet(&self) -> &'a RayPacket<V> {
+        self.p
+    }
+
+    #[inline(always)]
+    fn test(&self, tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
+        let p = self.p;
+        // Corners relative to the origins, permuted into (kx, ky, kz) order: by indexing when every lane shares
+        // the permutation, by per-lane selects otherwise. Both give each lane exactly `v[k] - o[k]`.
+        let corners = match &self.uniform {
+            Some((k, org)) => {
+                [rel_uniform(org, &tri[0], *k), rel_uniform(org, &tri[1], *k), rel_uniform(org, &tri[2], *k)]
+            }
+            None => [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])],
+        };
+        let fns = edge_functions(corners, p.shear);
+        if (fns.undecided() & active).none() {
+            return LaneHits::none();
+        }
+        let edges = fns.distance(p.tmin, tmax);
+        let exact_zero = edges.exact_zero & active;
+        if ((edges.maybe | edges.exact_zero) & active).none() {
+            // Every lane misses: no division.
+            return LaneHits::none();
+        }
+        let lanes = edges.finish(p.tmin, tmax);
+        let mut mask = lanes.hit & active;
+        let (mut t, mut bu, mut bv) = (lanes.t, lanes.u, lanes.v);
+        if exact_zero.any() {
+            // Rare: an edge function is exactly zero, and the paper recomputes it in double precision. Let the
+            // scalar test, which does exactly that, decide those lanes.
+            let bits = exact_zero.bits();
+            let (mut ta, mut ua, mut va) =
+                ([0.0f32; super::MAX_LANES], [0.0f32; super::MAX_LANES], [0.0f32; super::MAX_LANES]);
+            t.write_to(&mut ta[..V::LANES]);
+            bu.write_to(&mut ua[..V::LANES]);
+            bv.write_to(&mut va[..V::LANES]);
+            let mut hit_bits = mask.bits();
+            for i in (0..V::LANES).filter(|i| bits >> i & 1 == 1) {
+                let ray = p.ray(i);
+                if let Some(h) = crate::triangle::RayShear::new(&ray).intersect(tri, ray.tmin, tmax.lane(i)) {
+                    (ta[i], ua[i], va[i]) = (h.t, h.u, h.v);
+                    hit_bits |= 1 << i;
+                }
+            }
+            mask = V::Mask::from_bits(hit_bits);
+            t = V::from_slice(&ta[..V::LANES]);
+            bu = V::from_slice(&ua[..V::LANES]);
+            bv = V::from_slice(&va[..V::LANES]);
+        }
+        LaneHits { mask, t, u: bu, v: bv }
+    }
+
+    /// Tests triangle `id` (corners `tri`) against the `active` lanes and keeps closer hits in `hits`,
+    /// accepting `tmin < t <= hits.t` per lane as the scalar test does. Returns the lanes that hit it.
+    #[inline(always)]
+    pub fn intersect(&self, hits: &mut PacketHits<V>, tri: &[Vec3; 3], id: u32, active: V::Mask) -> V::Mask {
+        let r = self.test(tri, active, hits.t);
+        let mut mask = r.mask;
+        if mask.any() {
+            // A hit exactly as far as a lane's current one goes to the lower triangle id: `Hit::beats`'s rule,
+            // lane by lane (the test already kept only hits no farther than the current ones).
+            let ties = mask & r.t.eq(hits.t);
+            if ties.any() {
+                let mut bits = ties.bits();
+                let mut keep = mask.bits();
+                while bits != 0 {
+                    let lane = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    if hits.tri.lane(lane).to_bits() < id {
+                        keep &= !(1 << lane);
+                    }
+                }
+                mask = V::Mask::from_bits(keep);
+            }
+            hits.t = V::select(mask, r.t, hits.t);
+            hits.u = V::select(mask, r.u, hits.u);
+            hits.v = V::select(mask, r.v, hits.v);
+            hits.tri = V::select(mask, V::splat(f32::from_bits(id)), hits.tri);
+            hits.hit = hits.hit | mask;
+        }
+        mask
+    }
+
+    /// The `active` lanes that meet triangle `tri` within `(tmin, tmax]`, and their distances (for edge-width
+    /// walks, which want every crossing, not the closest).
+    #[inline(always)]
+    pub(crate) fn crossing(&self, tri: &[Vec3; 3], active: V::Mask) -> (V::Mask, V) {
+        let r = self.test(tri, active, self.p.tmax);
+        (r.mask, r.t)
+    }
+
+    /// The `active` lanes that triangle `tri` blocks within `(tmin, tmax]`.
+    #[inline(always)]
+    pub fn occlude(&self, tri: &[Vec3; 3], active: V::Mask) -> V::Mask {
+        self.test(tri, active, self.p.tmax).mask
+    }
+}
+
+/// Tests triangle `id` (corners `tri`) against the `active` lanes of `p` and keeps closer hits in `hits`
+/// ([`PacketTester::intersect`], for a single test). Returns the lanes that hit it.
 #[inline(always)]
 pub fn intersect_packet<V: Vf32>(
     p: &RayPacket<V>,
@@ -215,45 +295,14 @@ pub fn intersect_packet<V: Vf32>(
     id: u32,
     active: V::Mask,
 ) -> V::Mask {
-    let r = test(p, tri, active, hits.t);
-    let mut mask = r.mask;
-    if mask.any() {
-        // A hit exactly as far as a lane's current one goes to the lower triangle id: `Hit::beats`'s rule,
-        // lane by lane (the test already kept only hits no farther than the current ones).
-        let ties = mask & r.t.eq(hits.t);
-        if ties.any() {
-            let mut bits = ties.bits();
-            let mut keep = mask.bits();
-            while bits != 0 {
-                let lane = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                if hits.tri.lane(lane).to_bits() < id {
-                    keep &= !(1 << lane);
-                }
-            }
-            mask = V::Mask::from_bits(keep);
-        }
-        hits.t = V::select(mask, r.t, hits.t);
-        hits.u = V::select(mask, r.u, hits.u);
-        hits.v = V::select(mask, r.v, hits.v);
-        hits.tri = V::select(mask, V::splat(f32::from_bits(id)), hits.tri);
-        hits.hit = hits.hit | mask;
-    }
-    mask
+    PacketTester::new(p).intersect(hits, tri, id, active)
 }
 
-/// The `active` lanes that meet triangle `tri` within `(tmin, tmax]`, and their distances (for edge-width
-/// walks, which want every crossing, not the closest).
-#[inline(always)]
-pub(crate) fn crossing_packet<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask) -> (V::Mask, V) {
-    let r = test(p, tri, active, p.tmax);
-    (r.mask, r.t)
-}
-
-/// The `active` lanes that triangle `tri` blocks within `(tmin, tmax]`.
+/// The `active` lanes of `p` that triangle `tri` blocks within `(tmin, tmax]` ([`PacketTester::occlude`], for a
+/// single test).
 #[inline(always)]
 pub fn occlude_packet<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3], active: V::Mask) -> V::Mask {
-    test(p, tri, active, p.tmax).mask
+    PacketTester::new(p).occlude(tri, active)
 }
 
 #[cfg(test)]
