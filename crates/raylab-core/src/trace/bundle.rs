@@ -138,6 +138,12 @@ pub(super) fn toward_cone<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f
 /// when none is valid.
 #[inline(always)]
 pub(super) fn frustum_from<V: Vf32>(origin: Vec3, tile: &PacketTile<V>, set: Range<usize>) -> Option<Frustum> {
+    // From the batched culling data when the tile has it (the same frustum, a chunk of packets at a time).
+    if let Some(batch) = &tile.batch
+        && let Some(f) = batch.frustum::<V>(origin, set.clone(), &tile.farthest_hit)
+    {
+        return Some(f);
+    }
     Frustum::from_packets(origin, &tile.packets[set])
 }
 
