@@ -102,6 +102,19 @@ impl F32x4 {
             if _mm_movemask_ps(ordered) == 0 { f32::NAN } else { _mm_cvtss_f32(m) }
         })
     }
+
+    /// Lane `i` of the result folds the lanes of `rows[i]` with `op` (a lane-wise min or max), for four rows:
+    /// neighbouring lanes of row pairs, then the pairs' halves.
+    #[inline(always)]
+    fn fold_rows(rows: &[Self], op: impl Fn(__m128, __m128) -> __m128) -> Self {
+        let r: &[Self; 4] = rows[..4].try_into().expect("four rows");
+        sse!({
+            // [op(a0, a2), op(b0, b2), op(a1, a3), op(b1, b3)].
+            let pair = |a: Self, b: Self| op(_mm_unpacklo_ps(a.0, b.0), _mm_unpackhi_ps(a.0, b.0));
+            let (p, q) = (pair(r[0], r[1]), pair(r[2], r[3]));
+            Self(op(_mm_movelh_ps(p, q), _mm_movehl_ps(q, p)))
+        })
+    }
 }
 
 impl Vf32 for F32x4 {
@@ -168,6 +181,14 @@ impl Vf32 for F32x4 {
     #[inline(always)]
     fn reduce_max(self) -> f32 {
         self.reduce(f32::NEG_INFINITY, |a, b| sse!(_mm_max_ps(a, b)))
+    }
+    #[inline(always)]
+    fn reduce_min_each(rows: &[Self]) -> Self {
+        Self::fold_rows(rows, |a, b| sse!(_mm_min_ps(a, b)))
+    }
+    #[inline(always)]
+    fn reduce_max_each(rows: &[Self]) -> Self {
+        Self::fold_rows(rows, |a, b| sse!(_mm_max_ps(a, b)))
     }
     #[inline(always)]
     fn abs(self) -> Self {

@@ -117,6 +117,22 @@ impl F32x8 {
             if _mm256_movemask_ps(ordered) == 0 { f32::NAN } else { _mm_cvtss_f32(m) }
         })
     }
+
+    /// Lane `i` of the result folds the lanes of `rows[i]` with `op` (a lane-wise min or max), for eight rows:
+    /// neighbouring lanes of row pairs, then of row quadruples, then the two halves, 21 instructions in all.
+    #[inline(always)]
+    fn fold_rows(rows: &[Self], op: impl Fn(__m256, __m256) -> __m256) -> Self {
+        let r: &[Self; 8] = rows[..8].try_into().expect("eight rows");
+        avx!({
+            // Per half: [op(a0, a2), op(b0, b2), op(a1, a3), op(b1, b3)].
+            let pair = |a: Self, b: Self| op(_mm256_unpacklo_ps(a.0, b.0), _mm256_unpackhi_ps(a.0, b.0));
+            // Per half: each of the four rows folded over the half's lanes.
+            let quad = |p: __m256, q: __m256| op(_mm256_shuffle_ps::<0x44>(p, q), _mm256_shuffle_ps::<0xee>(p, q));
+            let low = quad(pair(r[0], r[1]), pair(r[2], r[3]));
+            let high = quad(pair(r[4], r[5]), pair(r[6], r[7]));
+            Self(op(_mm256_permute2f128_ps::<0x20>(low, high), _mm256_permute2f128_ps::<0x31>(low, high)))
+        })
+    }
 }
 
 impl Vf32 for F32x8 {
@@ -183,6 +199,14 @@ impl Vf32 for F32x8 {
     #[inline(always)]
     fn reduce_max(self) -> f32 {
         self.reduce(f32::NEG_INFINITY, |a, b| avx!(_mm_max_ps(a, b)))
+    }
+    #[inline(always)]
+    fn reduce_min_each(rows: &[Self]) -> Self {
+        Self::fold_rows(rows, |a, b| avx!(_mm256_min_ps(a, b)))
+    }
+    #[inline(always)]
+    fn reduce_max_each(rows: &[Self]) -> Self {
+        Self::fold_rows(rows, |a, b| avx!(_mm256_max_ps(a, b)))
     }
     #[inline(always)]
     fn abs(self) -> Self {
