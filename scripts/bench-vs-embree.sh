@@ -3,7 +3,7 @@
 # single-ray table of docs/BENCHMARKS.md with `raylab-bench compare`, which runs Embree and raylab on the same
 # OBJ, view, light and rays in one invocation. Run it on a committed tree: the table records the commit.
 #
-#   scripts/bench-vs-embree.sh            # 512x512, threads 1 and 2, 3 rounds of 5 timed runs each
+#   scripts/bench-vs-embree.sh            # 512x512, threads 1 and 2, 7 rounds of 5 timed runs each
 #   REPS=3 ROUNDS=5 scripts/bench-vs-embree.sh
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -11,7 +11,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 source "$root/scripts/lib/splice.sh"
 shared=${SHARED:-$root/../shared}
 reps=${REPS:-5}
-rounds=${ROUNDS:-3}
+rounds=${ROUNDS:-7}
 harness=$root/target/embree-bench
 mkdir -p "$harness"
 cp "$shared/tools/embree-bench/embree_bench.cpp" "$shared/tools/embree-bench/Makefile" "$harness/"
