@@ -13,7 +13,7 @@ use std::ops::Range;
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{Frustum, MAX_LANES, RayPacket};
+use super::{Frustum, MAX_LANES, RayPacket, SignBounds};
 use crate::aabb::Aabb;
 
 /// The culling data of up to [`MAX_LANES`] packets, one per lane, relative to the tile's common origin.
@@ -112,8 +112,7 @@ impl BatchCull {
             return None;
         }
         let (zero, inf, ninf) = (V::splat(0.0), V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
-        let (mut pos_near, mut pos_far, mut neg_near, mut neg_far) = ([inf; 3], [ninf; 3], [ninf; 3], [inf; 3]);
-        let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
+        let mut sides = SignBounds::<V>::new();
         let (mut t_min, mut t_max) = (inf, ninf);
         for chunk in set.start / V::LANES..set.end.div_ceil(V::LANES) {
             let base = chunk * V::LANES;
@@ -128,29 +127,10 @@ impl BatchCull {
                     return None;
                 }
                 // A ranged packet's inverses on the axis all have the sign of its range.
-                let pos = members & lo.gt(zero);
-                let neg = members & hi.lt(zero);
-                any_pos[k] |= pos.any();
-                any_neg[k] |= neg.any();
-                pos_near[k] = pos_near[k].min(V::select(pos, lo, inf));
-                pos_far[k] = pos_far[k].max(V::select(pos, hi, ninf));
-                neg_near[k] = neg_near[k].max(V::select(neg, hi, ninf));
-                neg_far[k] = neg_far[k].min(V::select(neg, lo, inf));
+                sides.add(k, members & lo.gt(zero), members & hi.lt(zero), lo, hi);
             }
         }
-        let mut f = Frustum {
-            origin,
-            // Written out rather than with `map3` (see `Frustum::from_packets`).
-            pos_near: [pos_near[0].reduce_min(), pos_near[1].reduce_min(), pos_near[2].reduce_min()],
-            pos_far: [pos_far[0].reduce_max(), pos_far[1].reduce_max(), pos_far[2].reduce_max()],
-            neg_near: [neg_near[0].reduce_max(), neg_near[1].reduce_max(), neg_near[2].reduce_max()],
-            neg_far: [neg_far[0].reduce_min(), neg_far[1].reduce_min(), neg_far[2].reduce_min()],
-            t_min: t_min.reduce_min(),
-            t_max: t_max.reduce_max(),
-            origin_slack: 0.0,
-        };
-        f.close_sides(any_pos, any_neg);
-        Some(f)
+        Some(sides.frustum(origin, t_min.reduce_min(), t_max.reduce_max()))
     }
 }
 

@@ -15,6 +15,7 @@ use crate::ray::{Hit, Ray};
 pub use batch_cull::BatchCull;
 pub use cone::Cone;
 pub use disc::Disc;
+pub(crate) use tile::SignBounds;
 pub use tile::{Bundle, Frustum, PacketTile, overlaps_box, packet_shape, slab_interval};
 pub use woop::{PacketTester, intersect_packet, occlude_packet};
 pub(crate) use woop::{Sheared, sheared_test};

@@ -362,11 +362,8 @@ impl Frustum {
     /// inverse directions (no division per ray).
     #[inline(always)]
     pub fn from_packets<V: Vf32>(origin: Vec3, packets: &[RayPacket<V>]) -> Option<Self> {
-        let inf = V::splat(f32::INFINITY);
-        let ninf = V::splat(f32::NEG_INFINITY);
-        let zero = V::splat(0.0);
-        let (mut pos_near, mut pos_far, mut neg_near, mut neg_far) = ([inf; 3], [ninf; 3], [ninf; 3], [inf; 3]);
-        let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
+        let (inf, ninf, zero) = (V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY), V::splat(0.0));
+        let mut sides = SignBounds::<V>::new();
         let (mut t_min, mut t_max) = (inf, ninf);
         let mut any = false;
         for p in packets {
@@ -378,39 +375,80 @@ impl Frustum {
             t_max = V::select(p.valid, p.tmax.max(t_max), t_max);
             for k in 0..3 {
                 let pos = p.valid & p.inv[k].gt(zero);
-                let neg = p.valid & !p.inv[k].gt(zero);
-                any_pos[k] |= pos.any();
-                any_neg[k] |= neg.any();
-                pos_near[k] = V::select(pos, p.inv[k].min(pos_near[k]), pos_near[k]);
-                pos_far[k] = V::select(pos, p.inv[k].max(pos_far[k]), pos_far[k]);
-                neg_near[k] = V::select(neg, p.inv[k].max(neg_near[k]), neg_near[k]);
-                neg_far[k] = V::select(neg, p.inv[k].min(neg_far[k]), neg_far[k]);
+                sides.add(k, pos, p.valid & !pos, p.inv[k], p.inv[k]);
             }
         }
         if !any {
             return None;
         }
+        Some(sides.frustum(origin, t_min.reduce_min(), t_max.reduce_max()))
+    }
+}
+
+/// Per-lane running bounds of a bundle's inverse directions on each axis, by sign, and the frustum they
+/// give: what [`Frustum::from_packets`], the batched frustums of [`super::BatchCull`] and the frustums of
+/// shadow segments seen from a light accumulate, each from its own lanes (rays or packets' ranges).
+pub(crate) struct SignBounds<V: Vf32> {
+    pos_near: [V; 3],
+    pos_far: [V; 3],
+    neg_near: [V; 3],
+    neg_far: [V; 3],
+    any_pos: [bool; 3],
+    any_neg: [bool; 3],
+}
+
+impl<V: Vf32> SignBounds<V> {
+    /// No lanes yet.
+    #[inline(always)]
+    pub fn new() -> Self {
+        let (inf, ninf) = (V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
+        Self {
+            pos_near: [inf; 3],
+            pos_far: [ninf; 3],
+            neg_near: [ninf; 3],
+            neg_far: [inf; 3],
+            any_pos: [false; 3],
+            any_neg: [false; 3],
+        }
+    }
+
+    /// Adds, on axis `k`, lanes `pos` whose inverse directions are positive and lanes `neg` whose are not,
+    /// each lane's inverses lying in `[lo, hi]` (`lo == hi` for a single ray).
+    #[inline(always)]
+    pub fn add(&mut self, k: usize, pos: V::Mask, neg: V::Mask, lo: V, hi: V) {
+        let (inf, ninf) = (V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
+        self.any_pos[k] |= pos.any();
+        self.any_neg[k] |= neg.any();
+        self.pos_near[k] = self.pos_near[k].min(V::select(pos, lo, inf));
+        self.pos_far[k] = self.pos_far[k].max(V::select(pos, hi, ninf));
+        self.neg_near[k] = self.neg_near[k].max(V::select(neg, hi, ninf));
+        self.neg_far[k] = self.neg_far[k].min(V::select(neg, lo, inf));
+    }
+
+    /// Whether any lane was added.
+    #[inline(always)]
+    pub fn any(&self) -> bool {
+        (0..3).any(|k| self.any_pos[k] || self.any_neg[k])
+    }
+
+    /// The frustum from `origin` with these bounds and distances `[t_min, t_max]` (`t_min` at least 0).
+    #[inline(always)]
+    pub fn frustum(&self, origin: Vec3, t_min: f32, t_max: f32) -> Frustum {
+        let (pn, pf, nn, nf) = (&self.pos_near, &self.pos_far, &self.neg_near, &self.neg_far);
         let mut f = Frustum {
             origin,
             // Written out: `map3` with `V::reduce_min` as a function item may call a shim that is neither inlined
             // nor compiled for the kernel's instruction set (seen in callgrind as `Fn::call` around `vcmpps`).
-            pos_near: [pos_near[0].reduce_min(), pos_near[1].reduce_min(), pos_near[2].reduce_min()],
-            pos_far: [pos_far[0].reduce_max(), pos_far[1].reduce_max(), pos_far[2].reduce_max()],
-            neg_near: [neg_near[0].reduce_max(), neg_near[1].reduce_max(), neg_near[2].reduce_max()],
-            neg_far: [neg_far[0].reduce_min(), neg_far[1].reduce_min(), neg_far[2].reduce_min()],
-            t_min: t_min.reduce_min().max(0.0),
-            t_max: t_max.reduce_max(),
+            pos_near: [pn[0].reduce_min(), pn[1].reduce_min(), pn[2].reduce_min()],
+            pos_far: [pf[0].reduce_max(), pf[1].reduce_max(), pf[2].reduce_max()],
+            neg_near: [nn[0].reduce_max(), nn[1].reduce_max(), nn[2].reduce_max()],
+            neg_far: [nf[0].reduce_min(), nf[1].reduce_min(), nf[2].reduce_min()],
+            t_min,
+            t_max,
             origin_slack: 0.0,
         };
-        for k in 0..3 {
-            if any_neg[k] || !any_pos[k] {
-                f.pos_far[k] = f32::INFINITY;
-            }
-            if any_pos[k] || !any_neg[k] {
-                f.neg_far[k] = f32::NEG_INFINITY;
-            }
-        }
-        Some(f)
+        f.close_sides(self.any_pos, self.any_neg);
+        f
     }
 }
 

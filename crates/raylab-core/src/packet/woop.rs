@@ -184,12 +184,6 @@ impl<'a, V: Vf32> PacketTester<'a, V> {
         Self { p, uniform }
     }
 
-    /// The packet.
-    #[inline(always)]
-    pub fn packet(&self) -> &'a RayPacket<V> {
-        self.p
-    }
-
     #[inline(always)]
     fn test(&self, tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
         let p = self.p;

@@ -8,7 +8,7 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
 use super::Tracer;
-use crate::packet::{Cone, Frustum, PacketTile, RayPacket, map3};
+use crate::packet::{Cone, Frustum, PacketTile, RayPacket, SignBounds, map3};
 use crate::ray::Ray;
 
 /// Relative size of the gap between a shadow segment's end and the light beyond which the segments are not
@@ -224,8 +224,7 @@ pub(super) fn toward_frustum<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit
     let (zero, inf, ninf) = (V::splat(0.0), V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
     let tw = [V::splat(toward.x), V::splat(toward.y), V::splat(toward.z)];
     let (mut gap_max, mut t_max) = (zero, ninf);
-    let (mut pos_near, mut pos_far, mut neg_near, mut neg_far) = ([inf; 3], [ninf; 3], [ninf; 3], [inf; 3]);
-    let (mut any_pos, mut any_neg) = ([false; 3], [false; 3]);
+    let mut sides = SignBounds::<V>::new();
     let mut sum = [zero; 3];
     for p in tile.packets[set.clone()].iter().filter(|p| p.valid.any()) {
         let valid = p.valid;
@@ -240,17 +239,11 @@ pub(super) fn toward_frustum<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit
         for k in 0..3 {
             let inv = V::splat(1.0) / d[k];
             let pos = inv.gt(zero) & valid;
-            let neg = valid & !pos;
-            any_pos[k] |= pos.any();
-            any_neg[k] |= neg.any();
-            pos_near[k] = pos_near[k].min(V::select(pos, inv, inf));
-            pos_far[k] = pos_far[k].max(V::select(pos, inv, ninf));
-            neg_near[k] = neg_near[k].max(V::select(neg, inv, ninf));
-            neg_far[k] = neg_far[k].min(V::select(neg, inv, inf));
+            sides.add(k, pos, valid & !pos, inv, inv);
             sum[k] = sum[k] + V::select(valid, d[k], zero);
         }
     }
-    if !(0..3).any(|k| any_pos[k] || any_neg[k]) {
+    if !sides.any() {
         return None;
     }
     let mut mean = [0.0f32; 3];
@@ -272,23 +265,7 @@ pub(super) fn toward_frustum<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit
     if spread.reduce_max() > spread_limit {
         return None;
     }
-    let mut f = Frustum {
-        origin: toward,
-        pos_near: [0.0; 3],
-        pos_far: [0.0; 3],
-        neg_near: [0.0; 3],
-        neg_far: [0.0; 3],
-        t_min: 0.0,
-        t_max: t_max.reduce_max(),
-        origin_slack: 0.0,
-    };
-    for k in 0..3 {
-        f.pos_near[k] = pos_near[k].reduce_min();
-        f.pos_far[k] = pos_far[k].reduce_max();
-        f.neg_near[k] = neg_near[k].reduce_max();
-        f.neg_far[k] = neg_far[k].reduce_min();
-    }
-    f.close_sides(any_pos, any_neg);
+    let mut f = sides.frustum(toward, 0.0, t_max.reduce_max());
     widen_toward(&mut f.t_max, &mut f.origin_slack, toward, gap_max.reduce_max());
     Some(f)
 }
