@@ -182,12 +182,8 @@ fn packet_intersect<V: Vf32>(
         return false;
     }
     stats.packets_tested += 1;
-    let mut packet_changed = false;
-    let tester = PacketTester::new(p);
-    for &id in ids {
-        stats.isect_tests += 1;
-        packet_changed |= tester.intersect(hits, tree.triangles().get(id), id, active).any();
-    }
+    stats.isect_tests += ids.len() as u64;
+    let packet_changed = PacketTester::new(p).intersect_each(hits, tree.triangles(), ids, active);
     if packet_changed {
         tile.farthest_hit[j] = hit_reach(V::select(p.valid, hits.t, V::splat(f32::NEG_INFINITY)).reduce_max());
     }
@@ -236,15 +232,9 @@ pub(super) fn leaf_occlude<V: Vf32, const SLOTS: usize>(
                 }
             }
             stats.packets_tested += 1;
-            let tester = PacketTester::new(p);
-            for &id in ids {
-                stats.isect_tests += 1;
-                blocked[j] = blocked[j] | tester.occlude(tree.triangles().get(id), open);
-                open = open & !blocked[j];
-                if open.none() {
-                    break;
-                }
-            }
+            let (hit, tests) = PacketTester::new(p).occlude_each(tree.triangles(), ids, open);
+            stats.isect_tests += tests as u64;
+            blocked[j] = blocked[j] | hit;
             finished += (p.valid & !blocked[j]).none() as usize;
         }
     }

@@ -76,11 +76,9 @@ struct ClosestHits<'a, V: Vf32> {
 impl<V: Vf32> PacketLeaf<V> for ClosestHits<'_, V> {
     #[inline(always)]
     fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask, _: V) -> (V, V::Mask) {
-        let tester = PacketTester::new(self.p);
-        for &id in &self.tree.tri_ids()[ids] {
-            self.tests += 1;
-            tester.intersect(self.hits, self.tree.triangles().get(id), id, active);
-        }
+        let ids = &self.tree.tri_ids()[ids];
+        self.tests += ids.len() as u64;
+        PacketTester::new(self.p).intersect_each(self.hits, self.tree.triangles(), ids, active);
         (crate::packet::hit_reach_lanes(self.hits.t), V::Mask::from_bits(0))
     }
 }
@@ -96,15 +94,12 @@ struct Blockers<'a, V: Vf32> {
 impl<V: Vf32> PacketLeaf<V> for Blockers<'_, V> {
     #[inline(always)]
     fn visit(&mut self, ids: std::ops::Range<usize>, active: V::Mask, _: V) -> (V, V::Mask) {
-        let mut open = active & !self.blocked;
-        let tester = PacketTester::new(self.p);
-        for &id in &self.tree.tri_ids()[ids] {
-            if open.none() {
-                break;
-            }
-            self.tests += 1;
-            self.blocked = self.blocked | tester.occlude(self.tree.triangles().get(id), open);
-            open = open & !self.blocked;
+        let open = active & !self.blocked;
+        if open.any() {
+            let ids = &self.tree.tri_ids()[ids];
+            let (hit, tests) = PacketTester::new(self.p).occlude_each(self.tree.triangles(), ids, open);
+            self.tests += tests as u64;
+            self.blocked = self.blocked | hit;
         }
         (self.p.tmax, self.blocked)
     }

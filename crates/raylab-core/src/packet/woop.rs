@@ -9,7 +9,7 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
 use super::{PacketHits, RayPacket};
-use crate::triangle::SCALED_FAR_SLACK;
+use crate::triangle::{SCALED_FAR_SLACK, TriangleSoup};
 
 /// Picks component `axis` of `(x, y, z)` per lane, given the lane masks "axis is 0" and "axis is 1".
 #[inline(always)]
@@ -23,6 +23,18 @@ fn rel_uniform<V: Vf32>(org: &[V; 3], v: &Vec3, [kx, ky, kz]: [usize; 3]) -> (V,
     // Indexing the corner where it lies loads each component straight from the triangle, with no copy first.
     let v: &[f32; 3] = v.as_ref();
     (V::splat(v[kx]) - org[0], V::splat(v[ky]) - org[1], V::splat(v[kz]) - org[2])
+}
+
+/// The three corners of `tri` relative to origins `org` (already in `(kx, ky, kz)` order), in that order.
+#[inline(always)]
+fn uniform_corners<V: Vf32>(org: &[V; 3], tri: &[Vec3; 3], k: [usize; 3]) -> [(V, V, V); 3] {
+    [rel_uniform(org, &tri[0], k), rel_uniform(org, &tri[1], k), rel_uniform(org, &tri[2], k)]
+}
+
+/// The three corners of `tri` relative to the packet's origins, each permuted per lane.
+#[inline(always)]
+fn permuted_corners<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3]) -> [(V, V, V); 3] {
+    [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])]
 }
 
 /// Corner `v` relative to the packet's origins, permuted per lane into that lane's `(kx, ky, kz)` order.
@@ -60,9 +72,10 @@ fn edge_functions<V: Vf32>(corners: [(V, V, V); 3], [sx, sy, sz]: [V; 3]) -> Edg
     let w = bx * ay - by * ax;
     let zero = V::splat(0.0);
     let exact_zero = u.eq(zero) | v.eq(zero) | w.eq(zero);
-    let neg = u.lt(zero) | v.lt(zero) | w.lt(zero);
-    let pos = u.gt(zero) | v.gt(zero) | w.gt(zero);
-    EdgeFunctions { u, v, w, z: [sz * a_z, sz * b_z, sz * c_z], exact_zero, one_side: !(neg & pos) }
+    // Both signs among the three: the smallest is negative and the largest positive. A NaN function may make
+    // this differ from comparing each one, but such a lane misses anyway (its determinant is NaN).
+    let mixed = u.min(v).min(w).lt(zero) & u.max(v).max(w).gt(zero);
+    EdgeFunctions { u, v, w, z: [sz * a_z, sz * b_z, sz * c_z], exact_zero, mixed }
 }
 
 /// The edge functions of [`edge_functions`] and what the distance needs of the corners.
@@ -74,18 +87,18 @@ struct EdgeFunctions<V: Vf32> {
     z: [V; 3],
     /// Lanes with an edge function of exactly zero.
     exact_zero: V::Mask,
-    /// Lanes whose edge functions do not take both signs: the ray passes inside the triangle's edges, or
-    /// meets an edge or a vertex.
-    one_side: V::Mask,
+    /// Lanes whose edge functions take both signs: the ray passes outside an edge (unless one is exactly
+    /// zero, which the double-precision fallback decides).
+    mixed: V::Mask,
 }
 
 impl<V: Vf32> EdgeFunctions<V> {
-    /// The lanes that may still hit, as far as the edges tell: on one side of every edge, or with an edge
-    /// function of exactly zero (which the scalar test's double-precision fallback decides). A packet test
-    /// whose active lanes have none skips the distance.
+    /// Whether every `active` lane misses, as far as the edges tell: each has edge functions of both signs
+    /// and none exactly zero (which the scalar test's double-precision fallback decides). Such a packet test
+    /// skips the distance.
     #[inline(always)]
-    fn undecided(&self) -> V::Mask {
-        self.one_side | self.exact_zero
+    fn all_miss(&self, active: V::Mask) -> bool {
+        (active & !(self.mixed & !self.exact_zero)).none()
     }
 
     /// The second step of [`sheared_test`]: the scaled distance, which decides every lane but the few that
@@ -93,14 +106,14 @@ impl<V: Vf32> EdgeFunctions<V> {
     /// the division and what follows it.
     #[inline(always)]
     fn distance(self, tmin: V, tmax: V) -> Edges<V> {
-        let Self { u, v, w, z: [az, bz, cz], exact_zero, one_side } = self;
+        let Self { u, v, w, z: [az, bz, cz], exact_zero, mixed } = self;
         let zero = V::splat(0.0);
         let det = u + v + w;
         let t_scaled = u * az + v * bz + w * cz;
         let abs_det = det.abs();
         let t_signed = V::select(det.lt(zero), zero - t_scaled, t_scaled);
         let inside = t_signed.gt(tmin * abs_det) & t_signed.le(tmax * abs_det * V::splat(SCALED_FAR_SLACK));
-        let maybe = !exact_zero & one_side & !det.eq(zero) & inside;
+        let maybe = !(exact_zero | mixed) & !det.eq(zero) & inside;
         Edges { maybe, exact_zero, det, t_scaled, v, w }
     }
 }
@@ -184,19 +197,27 @@ impl<'a, V: Vf32> PacketTester<'a, V> {
         Self { p, uniform }
     }
 
+    /// Corners of `tri` relative to the origins, permuted into (kx, ky, kz) order: by indexing when every lane
+    /// shares the permutation, by per-lane selects otherwise. Both give each lane exactly `v[k] - o[k]`.
+    #[inline(always)]
+    fn corners(&self, tri: &[Vec3; 3]) -> [(V, V, V); 3] {
+        match &self.uniform {
+            Some((k, org)) => uniform_corners(org, tri, *k),
+            None => permuted_corners(self.p, tri),
+        }
+    }
+
     #[inline(always)]
     fn test(&self, tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
+        self.test_corners(self.corners(tri), tri, active, tmax)
+    }
+
+    /// The watertight test of `tri`, whose corners relative to the origins are `corners`.
+    #[inline(always)]
+    fn test_corners(&self, corners: [(V, V, V); 3], tri: &[Vec3; 3], active: V::Mask, tmax: V) -> LaneHits<V> {
         let p = self.p;
-        // Corners relative to the origins, permuted into (kx, ky, kz) order: by indexing when every lane shares
-        // the permutation, by per-lane selects otherwise. Both give each lane exactly `v[k] - o[k]`.
-        let corners = match &self.uniform {
-            Some((k, org)) => {
-                [rel_uniform(org, &tri[0], *k), rel_uniform(org, &tri[1], *k), rel_uniform(org, &tri[2], *k)]
-            }
-            None => [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])],
-        };
         let fns = edge_functions(corners, p.shear);
-        if (fns.undecided() & active).none() {
+        if fns.all_miss(active) {
             return LaneHits::none();
         }
         let edges = fns.distance(p.tmin, tmax);
@@ -238,30 +259,65 @@ impl<'a, V: Vf32> PacketTester<'a, V> {
     #[inline(always)]
     pub fn intersect(&self, hits: &mut PacketHits<V>, tri: &[Vec3; 3], id: u32, active: V::Mask) -> V::Mask {
         let r = self.test(tri, active, hits.t);
-        let mut mask = r.mask;
-        if mask.any() {
-            // A hit exactly as far as a lane's current one goes to the lower triangle id: `Hit::beats`'s rule,
-            // lane by lane (the test already kept only hits no farther than the current ones).
-            let ties = mask & r.t.eq(hits.t);
-            if ties.any() {
-                let mut bits = ties.bits();
-                let mut keep = mask.bits();
-                while bits != 0 {
-                    let lane = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    if hits.tri.lane(lane).to_bits() < id {
-                        keep &= !(1 << lane);
+        keep_closer(hits, r, id)
+    }
+
+    /// [`PacketTester::intersect`] for each triangle `ids` of `tris`, in order; returns whether some lane's
+    /// closest hit changed. The choice between indexed and per-lane permutations is made once for the run
+    /// rather than per triangle, which keeps the loop free of it (a leaf's run of tests is the packet
+    /// methods' innermost loop).
+    #[inline(always)]
+    pub fn intersect_each(&self, hits: &mut PacketHits<V>, tris: &TriangleSoup, ids: &[u32], active: V::Mask) -> bool {
+        let mut changed = V::Mask::from_bits(0);
+        match &self.uniform {
+            Some((k, org)) => {
+                for &id in ids {
+                    let tri = tris.get(id);
+                    let r = self.test_corners(uniform_corners(org, tri, *k), tri, active, hits.t);
+                    changed = changed | keep_closer(hits, r, id);
+                }
+            }
+            None => {
+                for &id in ids {
+                    let tri = tris.get(id);
+                    let r = self.test_corners(permuted_corners(self.p, tri), tri, active, hits.t);
+                    changed = changed | keep_closer(hits, r, id);
+                }
+            }
+        }
+        changed.any()
+    }
+
+    /// The lanes of `open` that triangles `ids` of `tris` block within `(tmin, tmax]` ([`PacketTester::occlude`]
+    /// for each, in order, each test for the lanes still open), and how many tests it took: it stops once
+    /// every lane is blocked. The choice of permutation is made once for the run, as in
+    /// [`PacketTester::intersect_each`].
+    #[inline(always)]
+    pub fn occlude_each(&self, tris: &TriangleSoup, ids: &[u32], open: V::Mask) -> (V::Mask, usize) {
+        let (mut open, mut blocked) = (open, V::Mask::from_bits(0));
+        match &self.uniform {
+            Some((k, org)) => {
+                for (n, &id) in ids.iter().enumerate() {
+                    let tri = tris.get(id);
+                    blocked = blocked | self.test_corners(uniform_corners(org, tri, *k), tri, open, self.p.tmax).mask;
+                    open = open & !blocked;
+                    if open.none() {
+                        return (blocked, n + 1);
                     }
                 }
-                mask = V::Mask::from_bits(keep);
             }
-            hits.t = V::select(mask, r.t, hits.t);
-            hits.u = V::select(mask, r.u, hits.u);
-            hits.v = V::select(mask, r.v, hits.v);
-            hits.tri = V::select(mask, V::splat(f32::from_bits(id)), hits.tri);
-            hits.hit = hits.hit | mask;
+            None => {
+                for (n, &id) in ids.iter().enumerate() {
+                    let tri = tris.get(id);
+                    blocked = blocked | self.test_corners(permuted_corners(self.p, tri), tri, open, self.p.tmax).mask;
+                    open = open & !blocked;
+                    if open.none() {
+                        return (blocked, n + 1);
+                    }
+                }
+            }
         }
-        mask
+        (blocked, ids.len())
     }
 
     /// The `active` lanes that meet triangle `tri` within `(tmin, tmax]`, and their distances (for edge-width
@@ -277,6 +333,35 @@ impl<'a, V: Vf32> PacketTester<'a, V> {
     pub fn occlude(&self, tri: &[Vec3; 3], active: V::Mask) -> V::Mask {
         self.test(tri, active, self.p.tmax).mask
     }
+}
+
+/// Keeps the lanes of `r` (a test of triangle `id`) that are closer than `hits`' current ones, or as close
+/// with a lower triangle id (`Hit::beats`'s rule; the test already kept only hits no farther than the
+/// current ones). Returns the lanes that took it.
+#[inline(always)]
+fn keep_closer<V: Vf32>(hits: &mut PacketHits<V>, r: LaneHits<V>, id: u32) -> V::Mask {
+    let mut mask = r.mask;
+    if mask.any() {
+        let ties = mask & r.t.eq(hits.t);
+        if ties.any() {
+            let mut bits = ties.bits();
+            let mut keep = mask.bits();
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if hits.tri.lane(lane).to_bits() < id {
+                    keep &= !(1 << lane);
+                }
+            }
+            mask = V::Mask::from_bits(keep);
+        }
+        hits.t = V::select(mask, r.t, hits.t);
+        hits.u = V::select(mask, r.u, hits.u);
+        hits.v = V::select(mask, r.v, hits.v);
+        hits.tri = V::select(mask, V::splat(f32::from_bits(id)), hits.tri);
+        hits.hit = hits.hit | mask;
+    }
+    mask
 }
 
 /// Tests triangle `id` (corners `tri`) against the `active` lanes of `p` and keeps closer hits in `hits`
