@@ -153,6 +153,12 @@ impl TriangleSoup {
         Self { verts: ids.par_iter().with_min_len(GATHER_CHUNK).map(corners).collect() }
     }
 
+    /// A soup of the given corners (tests build small scenes this way).
+    #[cfg(test)]
+    pub(crate) fn from_corners(verts: Vec<[Vec3; 3]>) -> Self {
+        Self { verts }
+    }
+
     /// The corners of triangle `i`.
     #[inline]
     pub fn get(&self, i: u32) -> &[Vec3; 3] {

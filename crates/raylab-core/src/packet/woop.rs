@@ -25,16 +25,42 @@ fn rel_uniform<V: Vf32>(org: &[V; 3], v: &Vec3, [kx, ky, kz]: [usize; 3]) -> (V,
     (V::splat(v[kx]) - org[0], V::splat(v[ky]) - org[1], V::splat(v[kz]) - org[2])
 }
 
-/// The three corners of `tri` relative to origins `org` (already in `(kx, ky, kz)` order), in that order.
-#[inline(always)]
-fn uniform_corners<V: Vf32>(org: &[V; 3], tri: &[Vec3; 3], k: [usize; 3]) -> [(V, V, V); 3] {
-    [rel_uniform(org, &tri[0], k), rel_uniform(org, &tri[1], k), rel_uniform(org, &tri[2], k)]
+/// How a run of watertight tests gets a triangle's corners relative to the packet's origins, in each lane's
+/// `(kx, ky, kz)` order: one implementation per way, so that a leaf's loop of tests is compiled for one of
+/// them and carries neither the choice nor what the other way needs.
+trait Corners<V: Vf32>: Copy {
+    /// The corners of `tri`.
+    fn of(self, tri: &[Vec3; 3]) -> [(V, V, V); 3];
 }
 
-/// The three corners of `tri` relative to the packet's origins, each permuted per lane.
-#[inline(always)]
-fn permuted_corners<V: Vf32>(p: &RayPacket<V>, tri: &[Vec3; 3]) -> [(V, V, V); 3] {
-    [rel_permuted(p, tri[0]), rel_permuted(p, tri[1]), rel_permuted(p, tri[2])]
+/// Every lane shares the permutation `k`, and `org` holds the origins already in that order: corners by
+/// indexing.
+#[derive(Clone, Copy)]
+struct Indexed<'a, V: Vf32> {
+    k: [usize; 3],
+    org: &'a [V; 3],
+}
+
+impl<V: Vf32> Corners<V> for Indexed<'_, V> {
+    #[inline(always)]
+    fn of(self, tri: &[Vec3; 3]) -> [(V, V, V); 3] {
+        [
+            rel_uniform(self.org, &tri[0], self.k),
+            rel_uniform(self.org, &tri[1], self.k),
+            rel_uniform(self.org, &tri[2], self.k),
+        ]
+    }
+}
+
+/// Lanes with their own permutations: corners by per-lane selects.
+#[derive(Clone, Copy)]
+struct PerLane<'a, V: Vf32>(&'a RayPacket<V>);
+
+impl<V: Vf32> Corners<V> for PerLane<'_, V> {
+    #[inline(always)]
+    fn of(self, tri: &[Vec3; 3]) -> [(V, V, V); 3] {
+        [rel_permuted(self.0, tri[0]), rel_permuted(self.0, tri[1]), rel_permuted(self.0, tri[2])]
+    }
 }
 
 /// Corner `v` relative to the packet's origins, permuted per lane into that lane's `(kx, ky, kz)` order.
@@ -202,8 +228,8 @@ impl<'a, V: Vf32> PacketTester<'a, V> {
     #[inline(always)]
     fn corners(&self, tri: &[Vec3; 3]) -> [(V, V, V); 3] {
         match &self.uniform {
-            Some((k, org)) => uniform_corners(org, tri, *k),
-            None => permuted_corners(self.p, tri),
+            Some((k, org)) => Indexed { k: *k, org }.of(tri),
+            None => PerLane(self.p).of(tri),
         }
     }
 
@@ -268,22 +294,27 @@ impl<'a, V: Vf32> PacketTester<'a, V> {
     /// methods' innermost loop).
     #[inline(always)]
     pub fn intersect_each(&self, hits: &mut PacketHits<V>, tris: &TriangleSoup, ids: &[u32], active: V::Mask) -> bool {
-        let mut changed = V::Mask::from_bits(0);
         match &self.uniform {
-            Some((k, org)) => {
-                for &id in ids {
-                    let tri = tris.get(id);
-                    let r = self.test_corners(uniform_corners(org, tri, *k), tri, active, hits.t);
-                    changed = changed | keep_closer(hits, r, id);
-                }
-            }
-            None => {
-                for &id in ids {
-                    let tri = tris.get(id);
-                    let r = self.test_corners(permuted_corners(self.p, tri), tri, active, hits.t);
-                    changed = changed | keep_closer(hits, r, id);
-                }
-            }
+            Some((k, org)) => self.intersect_run(Indexed { k: *k, org }, hits, tris, ids, active),
+            None => self.intersect_run(PerLane(self.p), hits, tris, ids, active),
+        }
+    }
+
+    /// [`PacketTester::intersect_each`] with corners from `corners`.
+    #[inline(always)]
+    fn intersect_run(
+        &self,
+        corners: impl Corners<V>,
+        hits: &mut PacketHits<V>,
+        tris: &TriangleSoup,
+        ids: &[u32],
+        active: V::Mask,
+    ) -> bool {
+        let mut changed = V::Mask::from_bits(0);
+        for &id in ids {
+            let tri = tris.get(id);
+            let r = self.test_corners(corners.of(tri), tri, active, hits.t);
+            changed = changed | keep_closer(hits, r, id);
         }
         changed.any()
     }
@@ -294,27 +325,28 @@ impl<'a, V: Vf32> PacketTester<'a, V> {
     /// [`PacketTester::intersect_each`].
     #[inline(always)]
     pub fn occlude_each(&self, tris: &TriangleSoup, ids: &[u32], open: V::Mask) -> (V::Mask, usize) {
-        let (mut open, mut blocked) = (open, V::Mask::from_bits(0));
         match &self.uniform {
-            Some((k, org)) => {
-                for (n, &id) in ids.iter().enumerate() {
-                    let tri = tris.get(id);
-                    blocked = blocked | self.test_corners(uniform_corners(org, tri, *k), tri, open, self.p.tmax).mask;
-                    open = open & !blocked;
-                    if open.none() {
-                        return (blocked, n + 1);
-                    }
-                }
-            }
-            None => {
-                for (n, &id) in ids.iter().enumerate() {
-                    let tri = tris.get(id);
-                    blocked = blocked | self.test_corners(permuted_corners(self.p, tri), tri, open, self.p.tmax).mask;
-                    open = open & !blocked;
-                    if open.none() {
-                        return (blocked, n + 1);
-                    }
-                }
+            Some((k, org)) => self.occlude_run(Indexed { k: *k, org }, tris, ids, open),
+            None => self.occlude_run(PerLane(self.p), tris, ids, open),
+        }
+    }
+
+    /// [`PacketTester::occlude_each`] with corners from `corners`.
+    #[inline(always)]
+    fn occlude_run(
+        &self,
+        corners: impl Corners<V>,
+        tris: &TriangleSoup,
+        ids: &[u32],
+        open: V::Mask,
+    ) -> (V::Mask, usize) {
+        let (mut open, mut blocked) = (open, V::Mask::from_bits(0));
+        for (n, &id) in ids.iter().enumerate() {
+            let tri = tris.get(id);
+            blocked = blocked | self.test_corners(corners.of(tri), tri, open, self.p.tmax).mask;
+            open = open & !blocked;
+            if open.none() {
+                return (blocked, n + 1);
             }
         }
         (blocked, ids.len())
@@ -417,5 +449,110 @@ mod tests {
         lanes::<raylab_simd::scalar::F32x4>();
         #[cfg(target_arch = "x86_64")]
         lanes::<raylab_simd::sse::F32x4>();
+    }
+
+    /// A leaf's worth of triangles: a fan around the origin of the xy plane sharing edges and a vertex (exact
+    /// zero edge functions for rays through them), a copy of one fan triangle under another id (ties), a
+    /// triangle behind the others, and a degenerate one.
+    fn leaf() -> TriangleSoup {
+        let c = Vec3::new(0.0, 0.0, 5.0);
+        let ring: Vec<Vec3> = (0..6)
+            .map(|i| {
+                let a = i as f32 * std::f32::consts::TAU / 6.0;
+                c + Vec3::new(a.cos(), a.sin(), 0.1 * i as f32)
+            })
+            .collect();
+        let mut tris: Vec<[Vec3; 3]> = (0..6).map(|i| [c, ring[i], ring[(i + 1) % 6]]).collect();
+        tris.push(tris[2]);
+        tris.push([Vec3::new(-3.0, -3.0, 9.0), Vec3::new(3.0, -3.0, 9.0), Vec3::new(0.0, 3.0, 9.0)]);
+        tris.push([Vec3::new(0.1, 0.1, 4.0), Vec3::new(0.2, 0.2, 4.0), Vec3::new(0.3, 0.3, 4.0)]);
+        TriangleSoup::from_corners(tris)
+    }
+
+    /// Runs of tests against every triangle of a leaf equal the single tests, lane by lane and bit for bit,
+    /// on packets whose lanes share one permutation (indexed corners) and on packets whose lanes do not
+    /// (per-lane selects), for closest hits and for any hit.
+    fn runs<V: Vf32>() {
+        let tris = leaf();
+        let ids: Vec<u32> = (0..9).collect();
+        let o = Vec3::ZERO;
+        let shared = [
+            Vec3::new(0.0, 0.0, 5.0),
+            Vec3::new(1.0, 0.0, 5.0),
+            Vec3::new(0.3, 0.4, 5.0),
+            Vec3::new(0.5, 0.866_025_4, 5.0),
+            Vec3::new(-0.2, 0.1, 5.0),
+            Vec3::new(2.5, 2.5, 5.0),
+            Vec3::new(0.0, -0.5, 5.0),
+            Vec3::new(-0.9, -0.1, 5.0),
+        ];
+        let mixed = [
+            Vec3::new(0.0, 0.0, 5.0),
+            Vec3::new(6.0, 0.2, 5.0),
+            Vec3::new(-0.1, 0.1, -5.0),
+            Vec3::new(0.3, 7.0, 5.0),
+            Vec3::new(0.2, 0.2, 4.5),
+            Vec3::new(-8.0, 0.0, 5.0),
+            Vec3::new(0.0, -0.4, 5.0),
+            Vec3::new(0.1, 0.0, 0.0),
+        ];
+        // Inside the fan, away from its edges: every lane is blocked before the last triangle.
+        let covered = [
+            Vec3::new(0.3, 0.1, 5.0),
+            Vec3::new(0.1, 0.3, 5.0),
+            Vec3::new(-0.2, 0.2, 5.0),
+            Vec3::new(-0.3, -0.1, 5.0),
+            Vec3::new(0.1, -0.3, 5.0),
+            Vec3::new(0.3, -0.1, 5.0),
+            Vec3::new(-0.1, 0.25, 5.0),
+            Vec3::new(0.2, -0.25, 5.0),
+        ];
+        for (targets, uniform) in [(shared, true), (mixed, false), (covered, true)] {
+            for first in 0..targets.len() {
+                let rays: Vec<Option<Ray>> =
+                    (0..V::LANES).map(|i| Some(Ray::new(o, targets[(first + i) % targets.len()]))).collect();
+                let p = RayPacket::<V>::new(&rays);
+                assert_eq!(p.uniform_axes.is_some(), uniform, "lanes from {first}");
+                let tester = PacketTester::new(&p);
+
+                let (mut one, mut run) = (PacketHits::new(&p), PacketHits::new(&p));
+                let mut changed = false;
+                for &id in &ids {
+                    changed |= tester.intersect(&mut one, tris.get(id), id, p.valid).any();
+                }
+                assert_eq!(tester.intersect_each(&mut run, &tris, &ids, p.valid), changed);
+                for i in 0..V::LANES {
+                    let (a, b) = (one.get(i), run.get(i));
+                    assert_eq!(
+                        a.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.tri)),
+                        b.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.tri)),
+                        "lane {i}"
+                    );
+                }
+
+                let (mut open, mut blocked, mut tests) = (p.valid, V::Mask::from_bits(0), 0);
+                for &id in &ids {
+                    tests += 1;
+                    blocked = blocked | tester.occlude(tris.get(id), open);
+                    open = open & !blocked;
+                    if open.none() {
+                        break;
+                    }
+                }
+                let (got, got_tests) = tester.occlude_each(&tris, &ids, p.valid);
+                assert_eq!((got.bits(), got_tests), (blocked.bits(), tests), "lanes from {first}");
+                assert!(one.hit.any() && blocked.any(), "lanes from {first}: the packet meets the leaf");
+                if targets == covered {
+                    assert!(tests < ids.len(), "lanes from {first}: the run stops once all lanes are blocked");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn runs_of_tests_equal_single_tests() {
+        runs::<raylab_simd::scalar::F32x4>();
+        #[cfg(target_arch = "x86_64")]
+        runs::<raylab_simd::sse::F32x4>();
     }
 }
