@@ -431,7 +431,8 @@ impl<V: Vf32> SignBounds<V> {
         (0..3).any(|k| self.any_pos[k] || self.any_neg[k])
     }
 
-    /// The frustum from `origin` with these bounds and distances `[t_min, t_max]` (`t_min` at least 0).
+    /// The frustum from `origin` with these bounds and distances `[t_min, t_max]`, `t_min` raised to 0 when
+    /// negative (the walks start no nearer than the origin).
     #[inline(always)]
     pub fn frustum(&self, origin: Vec3, t_min: f32, t_max: f32) -> Frustum {
         let (pn, pf, nn, nf) = (&self.pos_near, &self.pos_far, &self.neg_near, &self.neg_far);
