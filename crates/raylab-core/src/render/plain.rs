@@ -1,0 +1,469 @@
+//! Shading a layer of plain surfaces a vector of hits at a time: where every hit of a block is diffuse and
+//! untextured and the frame's shadows are hard or off (the thesis's benchmark shading, 4.2.1: one point
+//! light, Lambert, no secondary rays), the surfaces, their shadow segments and their colours are computed
+//! in structure-of-arrays form with the backend's vectors instead of hit by hit.
+//!
+//! Every lane performs the operations of [`Surface::at`](super::shade::Surface::at),
+//! [`shadow_ray`](super::shade::shadow_ray) and [`Surface::local`](super::shade::Surface::local) in their
+//! order (glam's `Vec3` is scalar, and nothing is fused), so the colours are those of the per-hit path to
+//! the bit; only the bookkeeping differs: the per-hit path builds a `Surface` per hit, collects it, and walks
+//! the collections once per stage, which cost about as much as the arithmetic.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use raylab_simd::{Kernel, VMask, Vf32};
+
+use crate::packet::{MAX_LANES, map3};
+use crate::ray::{Hit, Ray};
+use crate::scene::{Material, MaterialKind, PointLight, Scene};
+use crate::shadow::Shadows;
+
+use super::shade::{AMBIENT, DIRECT};
+use super::{TileContext, TileOut};
+
+impl TileContext<'_> {
+    /// The colours of a block's primary rays `rays` and their hits (a `width x height` layer), when every hit
+    /// is on a plain surface ([`is_plain`]) and the frame's shadows are hard or off; `None` otherwise, and
+    /// the caller shades the layer hit by hit (`shade_layer`). The same colours either way; this way
+    /// Sponza's hard-shadow MFT frame takes 9% fewer instructions (docs/BENCHMARKS.md, session 54).
+    pub(super) fn shade_plain(
+        &self,
+        rays: &[Option<Ray>],
+        hits: &[Option<Hit>],
+        (width, height): (usize, usize),
+        out: &mut TileOut,
+        sc: &mut PlainScratch,
+    ) -> Option<Vec<Vec3>> {
+        let segments = match self.settings.shadows {
+            Shadows::Hard => true,
+            Shadows::None => false,
+            _ => return None,
+        };
+        let scene = self.scene;
+        let backend = self.tracer.options.backend;
+        let light = self.light.position;
+        let t0 = Instant::now();
+        let epsilon = self.epsilon;
+        let plain = Surfaces { scene, rays, hits, light, epsilon, segments, sc: &mut *sc };
+        if !raylab_simd::dispatch(backend, plain) {
+            return None;
+        }
+        let mut shading = t0.elapsed().as_secs_f64();
+        if segments {
+            let t = Instant::now();
+            sc.blocked.clear();
+            sc.blocked.resize(sc.rays.len(), false);
+            if sc.rays.iter().any(Option::is_some) {
+                self.tracer.occluded_tile(&sc.rays, width, height, Some(light), &mut sc.blocked, &mut out.stats);
+            }
+            sc.set_visible_from_blocked();
+            out.stages.shadow += t.elapsed().as_secs_f64();
+        } else {
+            sc.set_visible_where_hit(hits);
+        }
+        let t1 = Instant::now();
+        let colours = raylab_simd::dispatch(backend, Colours { hits, light: &self.light, sc });
+        shading += t1.elapsed().as_secs_f64();
+        out.stages.shading += shading;
+        Some(colours)
+    }
+}
+
+/// True for a plain material: diffuse and without textures, so a surface's colour is its base colour and it
+/// spawns no secondary ray.
+#[inline(always)]
+fn is_plain(m: &Material) -> bool {
+    m.kind == MaterialKind::Diffuse && m.diffuse_texture.is_none() && m.normal_texture.is_none()
+}
+
+/// A layer's plain surfaces in structure-of-arrays form, one entry per pixel of the layer (padded to whole
+/// vectors), kept between the shadow rays and the colours; reused from block to block.
+#[derive(Default)]
+pub(super) struct PlainScratch {
+    /// Hit points, one buffer per axis.
+    point: [Vec<f32>; 3],
+    /// Shading normals, turned toward the viewer.
+    normal: [Vec<f32>; 3],
+    /// Albedo (the material's base colour).
+    albedo: [Vec<f32>; 3],
+    /// Per pixel, how much of the light reaches it (0 or 1).
+    visible: Vec<f32>,
+    /// The shadow segments to the light (`None` where there is no hit or it faces away).
+    rays: Vec<Option<Ray>>,
+    /// Their occlusion.
+    blocked: Vec<bool>,
+}
+
+impl PlainScratch {
+    /// Sizes the buffers for `n` pixels, padded to whole vectors of the widest backend.
+    fn reset(&mut self, n: usize) {
+        let padded = n.div_ceil(MAX_LANES) * MAX_LANES;
+        for b in self.point.iter_mut().chain(&mut self.normal).chain(&mut self.albedo) {
+            b.clear();
+            b.resize(padded, 0.0);
+        }
+        self.visible.clear();
+        self.visible.resize(padded, 0.0);
+        self.rays.clear();
+        self.rays.resize(n, None);
+    }
+
+    /// How much of the light each pixel sees: 1 where its segment reached the light, 0 where it was
+    /// blocked, faces away, or has no hit.
+    fn set_visible_from_blocked(&mut self) {
+        for ((v, r), &b) in self.visible.iter_mut().zip(&self.rays).zip(&self.blocked) {
+            *v = if r.is_some() && !b { 1.0 } else { 0.0 };
+        }
+    }
+
+    /// Every pixel with a hit sees the whole light (shadows off).
+    fn set_visible_where_hit(&mut self, hits: &[Option<Hit>]) {
+        for (v, h) in self.visible.iter_mut().zip(hits) {
+            *v = if h.is_some() { 1.0 } else { 0.0 };
+        }
+    }
+}
+
+/// The surfaces of a layer's hits (`rays[i]` hit `hits[i]`, all plain), written into the scratch buffers,
+/// and, when `segments` is set, each surface's shadow segment to the light's centre.
+struct Surfaces<'a> {
+    scene: &'a Scene,
+    rays: &'a [Option<Ray>],
+    hits: &'a [Option<Hit>],
+    light: Vec3,
+    epsilon: f32,
+    segments: bool,
+    sc: &'a mut PlainScratch,
+}
+
+impl Kernel for Surfaces<'_> {
+    /// False, with the buffers half written, when some hit's surface is not plain.
+    type Output = bool;
+
+    #[inline(always)]
+    fn run<V: Vf32>(self) -> bool {
+        let Surfaces { scene, rays, hits, light, epsilon, segments, sc } = self;
+        sc.reset(rays.len());
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let interpolate = !scene.normals.is_empty();
+        // Each lane's ray and hit, and the triangle's face normal, material colour and vertex normals:
+        // quantity `q` of lane `i` in `lanes[q][i]` (see `QUANTITIES`). Lanes without a hit keep an earlier
+        // vector's values, whose results no one reads.
+        let mut lanes = [[0.0f32; MAX_LANES]; QUANTITIES];
+        for base in (0..rays.len()).step_by(V::LANES) {
+            let mut present = 0u32;
+            for i in 0..V::LANES.min(rays.len() - base) {
+                let (Some(r), Some(h)) = (rays[base + i], hits[base + i]) else { continue };
+                present |= 1 << i;
+                let tri = &scene.triangles[h.tri as usize];
+                let material = &scene.materials[tri.material as usize];
+                if !is_plain(material) {
+                    return false;
+                }
+                let face = scene.geometric_normal(h.tri as usize);
+                let albedo = material.base_color;
+                put(&mut lanes, i, 0, r.origin);
+                put(&mut lanes, i, 3, r.dir);
+                put(&mut lanes, i, 6, Vec3::new(h.t, h.u, h.v));
+                put(&mut lanes, i, 9, face);
+                put(&mut lanes, i, 12, albedo);
+                if interpolate {
+                    let [i0, i1, i2] = tri.v;
+                    put(&mut lanes, i, 15, scene.normals[i0 as usize]);
+                    put(&mut lanes, i, 18, scene.normals[i1 as usize]);
+                    put(&mut lanes, i, 21, scene.normals[i2 as usize]);
+                }
+            }
+            if present == 0 {
+                continue;
+            }
+            let (org, dir) = (quantity3::<V>(&lanes, 0), quantity3::<V>(&lanes, 3));
+            let [t, u, v] = quantity3::<V>(&lanes, 6);
+            let face = quantity3::<V>(&lanes, 9);
+            // Turned toward the side the ray came from (`Surface::at`).
+            let entering = dot(&face, &dir).lt(zero);
+            let geometric = map3([0, 1, 2], |k| V::select(entering, face[k], negate(face[k])));
+            // The interpolated normal, normalised, or the face normal where it vanishes
+            // (`Scene::shading_normal`).
+            let mut normal = face;
+            if interpolate {
+                let w = one - u - v;
+                let (n0, n1, n2) = (quantity3::<V>(&lanes, 15), quantity3::<V>(&lanes, 18), quantity3::<V>(&lanes, 21));
+                let n = [
+                    n0[0] * w + n1[0] * u + n2[0] * v,
+                    n0[1] * w + n1[1] * u + n2[1] * v,
+                    n0[2] * w + n1[2] * u + n2[2] * v,
+                ];
+                let rcp = one / dot(&n, &n).sqrt();
+                let usable = rcp.abs().lt(V::splat(f32::INFINITY)) & rcp.gt(zero);
+                normal = map3([0, 1, 2], |k| V::select(usable, n[k] * rcp, face[k]));
+            }
+            let behind = dot(&normal, &geometric).lt(zero);
+            let normal = map3([0, 1, 2], |k| V::select(behind, negate(normal[k]), normal[k]));
+            let point = map3([0, 1, 2], |k| org[k] + dir[k] * t);
+            for k in 0..3 {
+                point[k].write_to(&mut sc.point[k][base..base + V::LANES]);
+                normal[k].write_to(&mut sc.normal[k][base..base + V::LANES]);
+                quantity::<V>(&lanes, 12 + k).write_to(&mut sc.albedo[k][base..base + V::LANES]);
+            }
+            if segments {
+                let lit = V::Mask::from_bits(present);
+                write_segments(&point, &geometric, &normal, light, epsilon, lit, &mut sc.rays[base..]);
+            }
+        }
+        true
+    }
+}
+
+/// The shadow segments of one vector of surfaces to `light` (`shadow_ray` with the light's centre as the
+/// target), for the lanes of `lit`; a lane whose surface faces away from the light, or whose segment is
+/// empty or infinite, gets none.
+#[inline(always)]
+fn write_segments<V: Vf32>(
+    point: &[V; 3],
+    geometric: &[V; 3],
+    normal: &[V; 3],
+    light: Vec3,
+    epsilon: f32,
+    lit: V::Mask,
+    out: &mut [Option<Ray>],
+) {
+    let c = [V::splat(light.x), V::splat(light.y), V::splat(light.z)];
+    let to_light = map3([0, 1, 2], |k| c[k] - point[k]);
+    let faces_away = (dot(normal, &to_light) * dot(normal, geometric)).le(V::splat(0.0));
+    let eps = V::splat(epsilon);
+    let q = map3([0, 1, 2], |k| point[k] + geometric[k] * eps);
+    let v = map3([0, 1, 2], |k| c[k] - q[k]);
+    let d = dot(&v, &v).sqrt();
+    let dir = map3([0, 1, 2], |k| v[k] / d);
+    let ok = lit & !faces_away & d.gt(V::splat(0.0)) & d.abs().lt(V::splat(f32::INFINITY));
+    let bits = ok.bits();
+    let mut rows = [[0.0f32; MAX_LANES]; 7];
+    for (row, x) in rows.iter_mut().zip([q[0], q[1], q[2], dir[0], dir[1], dir[2], d]) {
+        x.write_to(&mut row[..V::LANES]);
+    }
+    for (i, o) in out.iter_mut().take(V::LANES).enumerate() {
+        *o = (bits >> i & 1 == 1).then(|| {
+            let origin = Vec3::new(rows[0][i], rows[1][i], rows[2][i]);
+            Ray::segment(origin, Vec3::new(rows[3][i], rows[4][i], rows[5][i]), 0.0, rows[6][i])
+        });
+    }
+}
+
+/// The colours of a layer's plain surfaces (from [`Surfaces`]) lit by `light` with the scratch's
+/// visibility: `albedo * (ambient + direct * N.L * attenuation * visibility)` as [`Surface::local`]
+/// computes it for a diffuse material; black where there is no hit.
+///
+/// [`Surface::local`]: super::shade::Surface::local
+struct Colours<'a> {
+    hits: &'a [Option<Hit>],
+    light: &'a PointLight,
+    sc: &'a PlainScratch,
+}
+
+impl Kernel for Colours<'_> {
+    type Output = Vec<Vec3>;
+
+    #[inline(always)]
+    fn run<V: Vf32>(self) -> Vec<Vec3> {
+        let Colours { hits, light, sc } = self;
+        let n = hits.len();
+        let mut colours = vec![Vec3::ZERO; n];
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let lp = [V::splat(light.position.x), V::splat(light.position.y), V::splat(light.position.z)];
+        let (c0, c1, c2) = (V::splat(light.constant), V::splat(light.linear), V::splat(light.quadratic));
+        for base in (0..n).step_by(V::LANES) {
+            let point = [load::<V>(&sc.point[0], base), load::<V>(&sc.point[1], base), load::<V>(&sc.point[2], base)];
+            let normal =
+                [load::<V>(&sc.normal[0], base), load::<V>(&sc.normal[1], base), load::<V>(&sc.normal[2], base)];
+            let to_light = map3([0, 1, 2], |k| lp[k] - point[k]);
+            let dist = dot(&to_light, &to_light).sqrt();
+            let away = dist.gt(zero);
+            let l = map3([0, 1, 2], |k| V::select(away, to_light[k] / dist, normal[k]));
+            let ndl = dot(&normal, &l);
+            // `f32::max(ndl, 0.0)`: NaN and negative cosines give 0.
+            let ndl = V::select(ndl.gt(zero), ndl, zero);
+            let denom = c0 + c1 * dist + c2 * dist * dist;
+            let attenuation = V::select(denom.gt(one), one / denom, one);
+            let lit = load::<V>(&sc.visible, base) * attenuation;
+            let direct = V::splat(DIRECT) * (ndl * lit);
+            let mut rows = [[0.0f32; MAX_LANES]; 3];
+            for (k, row) in rows.iter_mut().enumerate() {
+                let c = load::<V>(&sc.albedo[k], base) * (V::splat(AMBIENT) + direct * V::splat(light.color[k]));
+                c.write_to(&mut row[..V::LANES]);
+            }
+            for (i, (o, h)) in colours[base..].iter_mut().zip(&hits[base..]).take(V::LANES).enumerate() {
+                if h.is_some() {
+                    *o = Vec3::new(rows[0][i], rows[1][i], rows[2][i]);
+                }
+            }
+        }
+        colours
+    }
+}
+
+/// How many per-lane quantities [`Surfaces`] gathers: origin (0-2), direction (3-5), hit distance and
+/// barycentrics (6-8), face normal (9-11), albedo (12-14) and the three vertex normals (15-23).
+const QUANTITIES: usize = 24;
+
+/// Quantity `q` of every lane as a vector.
+#[inline(always)]
+fn quantity<V: Vf32>(lanes: &[[f32; MAX_LANES]; QUANTITIES], q: usize) -> V {
+    V::from_slice(&lanes[q][..V::LANES])
+}
+
+/// Quantities `q..q + 3` of every lane as vectors.
+#[inline(always)]
+fn quantity3<V: Vf32>(lanes: &[[f32; MAX_LANES]; QUANTITIES], q: usize) -> [V; 3] {
+    [quantity(lanes, q), quantity(lanes, q + 1), quantity(lanes, q + 2)]
+}
+
+/// Stores `x` as quantities `q..q + 3` of lane `i`.
+#[inline(always)]
+fn put(lanes: &mut [[f32; MAX_LANES]; QUANTITIES], i: usize, q: usize, x: Vec3) {
+    (lanes[q][i], lanes[q + 1][i], lanes[q + 2][i]) = (x.x, x.y, x.z);
+}
+
+/// The vector of `b` that starts at `base`.
+#[inline(always)]
+fn load<V: Vf32>(b: &[f32], base: usize) -> V {
+    V::from_slice(&b[base..base + V::LANES])
+}
+
+/// `a . b` per lane, summed in glam's order.
+#[inline(always)]
+fn dot<V: Vf32>(a: &[V; 3], b: &[V; 3]) -> V {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `-x` per lane, exactly (a multiplication by -1 only flips the sign bit).
+#[inline(always)]
+fn negate<V: Vf32>(x: V) -> V {
+    x * V::splat(-1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use raylab_simd::{Backend, dispatch};
+
+    use super::*;
+    use crate::render::shade::{Surface, shadow_ray};
+    use crate::scene::{SceneBuilder, Triangle};
+
+    /// A small deterministic generator in `[-1, 1)` (no dependency for a test).
+    fn next(state: &mut u64) -> f32 {
+        *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((*state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+    }
+
+    fn point(state: &mut u64, scale: f32) -> Vec3 {
+        Vec3::new(next(state), next(state), next(state)) * scale
+    }
+
+    /// Random triangles of two diffuse colours, with random vertex normals (triangle 0's cancel out at
+    /// `u = 0.5, v = 0`) when `normals` is set, or none; a third, specular material on the last triangle.
+    fn scene(normals: bool, state: &mut u64) -> Scene {
+        let mut b = SceneBuilder::new();
+        let n = 30;
+        b.positions = (0..3 * n).map(|_| point(state, 5.0)).collect();
+        if normals {
+            b.normals = (0..3 * n).map(|_| point(state, 1.0)).collect();
+            (b.normals[0], b.normals[1], b.normals[2]) = (Vec3::X, Vec3::NEG_X, Vec3::ZERO);
+        }
+        b.triangles = (0..n as u32).map(|i| Triangle { v: [3 * i, 3 * i + 1, 3 * i + 2], material: i % 2 }).collect();
+        b.triangles[n - 1].material = 2;
+        b.materials = vec![
+            Material::diffuse("warm", Vec3::new(0.9, 0.6, 0.3)),
+            Material::diffuse("cool", Vec3::new(0.2, 0.5, 0.8)),
+            Material::specular("shiny", Vec3::ONE, 20.0, 0.5),
+        ];
+        b.build()
+    }
+
+    /// The plain path's shadow segments and colours are the per-hit path's (`Surface::at`, `shadow_ray`,
+    /// `Surface::local`) to the bit, on every backend, with and without vertex normals: hits from both
+    /// sides, a vanishing interpolated normal, a hit at the light itself, surfaces facing away from the
+    /// light, missing rays and hits, and a layer that is not a whole number of vectors.
+    #[test]
+    fn plain_shading_equals_the_per_hit_path_on_every_backend() {
+        let mut state = 5u64;
+        let light = PointLight {
+            position: Vec3::new(0.5, 1.0, -0.25),
+            color: Vec3::new(1.0, 0.9, 0.7),
+            constant: 0.5,
+            linear: 0.1,
+            quadratic: 0.02,
+            radius: 0.0,
+        };
+        let epsilon = 1e-3;
+        for normals in [true, false] {
+            let scene = scene(normals, &mut state);
+            let plain_tris = scene.triangles.len() as u32 - 1;
+            let mut rays = Vec::new();
+            let mut hits = Vec::new();
+            for i in 0..37u32 {
+                let origin = point(&mut state, 8.0);
+                let dir = point(&mut state, 1.0).normalize();
+                let (u, v) = (next(&mut state).abs() * 0.5, next(&mut state).abs() * 0.5);
+                let hit = Hit { t: 1.0 + 4.0 * next(&mut state).abs(), tri: i % plain_tris, u, v };
+                let (ray, hit) = match i {
+                    3 => (None, None),
+                    5 => (Some(Ray::new(origin, dir)), None),
+                    // Triangle 0's normals cancel out here: the face normal stands in.
+                    7 => (Some(Ray::new(origin, dir)), Some(Hit { tri: 0, u: 0.5, v: 0.0, ..hit })),
+                    // The hit point is the light: no segment, and the normal stands in for the light direction.
+                    11 => (Some(Ray::new(light.position + Vec3::Z * 2.0, Vec3::NEG_Z)), Some(Hit { t: 2.0, ..hit })),
+                    _ => (Some(Ray::new(origin, dir)), Some(hit)),
+                };
+                rays.push(ray);
+                hits.push(hit);
+            }
+            let blocked: Vec<bool> = (0..rays.len()).map(|i| i % 4 == 1).collect();
+            let surfaces: Vec<Option<Surface>> =
+                rays.iter().zip(&hits).map(|(r, h)| Some(Surface::at(&scene, r.as_ref()?, h.as_ref()?))).collect();
+            let segments: Vec<Option<Ray>> =
+                surfaces.iter().map(|s| shadow_ray(s.as_ref()?, light.position, light.position, epsilon)).collect();
+            assert!(segments.iter().filter(|s| s.is_some()).count() > 10, "some surfaces face the light");
+            assert!(segments.iter().zip(&hits).filter(|(s, h)| s.is_none() && h.is_some()).count() > 3);
+            let colours: Vec<[u32; 3]> = surfaces
+                .iter()
+                .zip(&rays)
+                .enumerate()
+                .map(|(i, (s, r))| match (s, r) {
+                    (Some(s), Some(r)) => {
+                        let visible = if segments[i].is_some() && !blocked[i] { 1.0 } else { 0.0 };
+                        s.local(r.dir, &light, visible).to_array().map(f32::to_bits)
+                    }
+                    _ => [0; 3],
+                })
+                .collect();
+            for backend in Backend::available() {
+                let mut sc = PlainScratch::default();
+                let (rays, hits) = (&rays, &hits);
+                let kernel =
+                    Surfaces { scene: &scene, rays, hits, light: light.position, epsilon, segments: true, sc: &mut sc };
+                assert!(dispatch(backend, kernel), "{backend:?}: every surface is plain");
+                assert_eq!(sc.rays, segments, "{backend:?}, normals {normals}: shadow segments");
+                sc.blocked = blocked.clone();
+                sc.set_visible_from_blocked();
+                let got = dispatch(backend, Colours { hits, light: &light, sc: &sc });
+                let got: Vec<[u32; 3]> = got.iter().map(|c| c.to_array().map(f32::to_bits)).collect();
+                assert_eq!(got, colours, "{backend:?}, normals {normals}: colours");
+                // One hit on the specular triangle sends the layer down the per-hit path.
+                let mut mixed = hits.clone();
+                mixed[20] = mixed[20].map(|h| Hit { tri: plain_tris, ..h });
+                let kernel = Surfaces {
+                    scene: &scene,
+                    rays,
+                    hits: &mixed,
+                    light: light.position,
+                    epsilon,
+                    segments: true,
+                    sc: &mut sc,
+                };
+                assert!(!dispatch(backend, kernel), "{backend:?}: a specular surface is not plain");
+            }
+        }
+    }
+}
