@@ -103,6 +103,7 @@ pub fn shade_reflection_set(
         order: super::RayOrder::Scanline,
         tile: settings.tile,
         offsets: Vec::new(),
+        plain: super::plain::PlainMaterials::of(scene),
     };
     let sets: Vec<(Vec<Vec3>, TileOut)> = set
         .par_chunks(chunk)

@@ -138,6 +138,7 @@ pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight
         order,
         tile,
         offsets: order.offsets(tile, tile),
+        plain: plain::PlainMaterials::of(scene),
     };
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(tile)).flat_map(|ty| (0..w.div_ceil(tile)).map(move |tx| (tx * tile, ty * tile))).collect();
@@ -258,6 +259,8 @@ struct TileContext<'a> {
     tile: u32,
     /// The pixel offsets of a whole tile in `order`, computed once per frame.
     offsets: Vec<(u32, u32)>,
+    /// Which of the scene's materials the plain shading path takes ([`plain::PlainMaterials`]).
+    plain: plain::PlainMaterials,
 }
 
 /// Buffers of one block of rays and the shadow techniques' state, reused from block to block and from tile to

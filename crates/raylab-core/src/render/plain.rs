@@ -40,12 +40,17 @@ impl TileContext<'_> {
             Shadows::None => false,
             _ => return None,
         };
+        let check = match self.plain {
+            PlainMaterials::All => false,
+            PlainMaterials::Some => true,
+            PlainMaterials::None => return None,
+        };
         let scene = self.scene;
         let backend = self.tracer.options.backend;
         let light = self.light.position;
         let t0 = Instant::now();
         let epsilon = self.epsilon;
-        let plain = Surfaces { scene, rays, hits, light, epsilon, segments, sc: &mut *sc };
+        let plain = Surfaces { scene, rays, hits, light, epsilon, segments, check, sc: &mut *sc };
         if !raylab_simd::dispatch(backend, plain) {
             return None;
         }
@@ -67,6 +72,27 @@ impl TileContext<'_> {
         shading += t1.elapsed().as_secs_f64();
         out.stages.shading += shading;
         Some(colours)
+    }
+}
+
+/// Which of a scene's materials are plain ([`is_plain`]), found once per frame: with all of them, the plain
+/// path looks at no hit's material; with none, it is not tried.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PlainMaterials {
+    All,
+    Some,
+    None,
+}
+
+impl PlainMaterials {
+    /// The plain materials of `scene`.
+    pub(super) fn of(scene: &Scene) -> Self {
+        let plain = scene.materials.iter().filter(|m| is_plain(m)).count();
+        match plain {
+            0 => Self::None,
+            n if n == scene.materials.len() => Self::All,
+            _ => Self::Some,
+        }
     }
 }
 
@@ -134,6 +160,8 @@ struct Surfaces<'a> {
     light: Vec3,
     epsilon: f32,
     segments: bool,
+    /// Whether to check each hit's material (some of the scene's are not plain).
+    check: bool,
     sc: &'a mut PlainScratch,
 }
 
@@ -143,7 +171,7 @@ impl Kernel for Surfaces<'_> {
 
     #[inline(always)]
     fn run<V: Vf32>(self) -> bool {
-        let Surfaces { scene, rays, hits, light, epsilon, segments, sc } = self;
+        let Surfaces { scene, rays, hits, light, epsilon, segments, check, sc } = self;
         sc.reset(rays.len());
         let (zero, one) = (V::splat(0.0), V::splat(1.0));
         let interpolate = !scene.normals.is_empty();
@@ -158,7 +186,7 @@ impl Kernel for Surfaces<'_> {
                 present |= 1 << i;
                 let tri = &scene.triangles[h.tri as usize];
                 let material = &scene.materials[tri.material as usize];
-                if !is_plain(material) {
+                if check && !is_plain(material) {
                     return false;
                 }
                 let face = scene.geometric_normal(h.tri as usize);
@@ -381,6 +409,18 @@ mod tests {
         b.build()
     }
 
+    #[test]
+    fn a_scene_is_plain_when_its_materials_are() {
+        let mut state = 9u64;
+        let mut scene = scene(false, &mut state);
+        assert_eq!(PlainMaterials::of(&scene), PlainMaterials::Some);
+        scene.materials.truncate(2);
+        assert_eq!(PlainMaterials::of(&scene), PlainMaterials::All);
+        scene.materials[0].diffuse_texture = Some(0);
+        scene.materials[1].kind = MaterialKind::Reflective;
+        assert_eq!(PlainMaterials::of(&scene), PlainMaterials::None);
+    }
+
     /// The plain path's shadow segments and colours are the per-hit path's (`Surface::at`, `shadow_ray`,
     /// `Surface::local`) to the bit, on every backend, with and without vertex normals: hits from both
     /// sides, a vanishing interpolated normal, a hit at the light itself, surfaces facing away from the
@@ -441,10 +481,14 @@ mod tests {
             for backend in Backend::available() {
                 let mut sc = PlainScratch::default();
                 let (rays, hits) = (&rays, &hits);
-                let kernel =
-                    Surfaces { scene: &scene, rays, hits, light: light.position, epsilon, segments: true, sc: &mut sc };
-                assert!(dispatch(backend, kernel), "{backend:?}: every surface is plain");
-                assert_eq!(sc.rays, segments, "{backend:?}, normals {normals}: shadow segments");
+                // Checked hit by hit (the scene has a specular material too) or not: every hit here is plain.
+                for check in [true, false] {
+                    let light = light.position;
+                    let kernel =
+                        Surfaces { scene: &scene, rays, hits, light, epsilon, segments: true, check, sc: &mut sc };
+                    assert!(dispatch(backend, kernel), "{backend:?}: every surface is plain");
+                    assert_eq!(sc.rays, segments, "{backend:?}, normals {normals}, check {check}: shadow segments");
+                }
                 sc.blocked = blocked.clone();
                 sc.set_visible_from_blocked();
                 let got = dispatch(backend, Colours { hits, light: &light, sc: &sc });
@@ -460,6 +504,7 @@ mod tests {
                     light: light.position,
                     epsilon,
                     segments: true,
+                    check: true,
                     sc: &mut sc,
                 };
                 assert!(!dispatch(backend, kernel), "{backend:?}: a specular surface is not plain");
