@@ -342,15 +342,13 @@ impl TileContext<'_> {
 
         let colors = match settings.view {
             FrameView::Normals | FrameView::Depth => Vec::new(),
-            _ => match self.shade_plain(&sc.rays, &sc.hits, (rw, rh), out, &mut sc.plain) {
-                Some(colors) => colors,
-                None => {
-                    sc.seeds.clear();
-                    sc.seeds.extend(sc.pixels.iter().map(|&(x, y)| y * self.width + x));
-                    let layer = whitted::Layer { rays: &sc.rays, hits: &sc.hits, dims: (rw, rh), seeds: &sc.seeds };
-                    self.shade_layer(layer, 0, out, &mut sc.shadow)
-                }
-            },
+            _ if self.shade_plain(&sc.pixels, &sc.rays, &sc.hits, (rw, rh), out, &mut sc.plain) => return,
+            _ => {
+                sc.seeds.clear();
+                sc.seeds.extend(sc.pixels.iter().map(|&(x, y)| y * self.width + x));
+                let layer = whitted::Layer { rays: &sc.rays, hits: &sc.hits, dims: (rw, rh), seeds: &sc.seeds };
+                self.shade_layer(layer, 0, out, &mut sc.shadow)
+            }
         };
         let t = Instant::now();
         let hits = sc.pixels.iter().zip(&sc.rays).zip(&sc.hits).enumerate().filter_map(|(i, ((&p, r), h))| {

@@ -19,31 +19,33 @@ use crate::ray::{Hit, Ray};
 use crate::scene::{Material, MaterialKind, PointLight, Scene};
 use crate::shadow::Shadows;
 
-use super::shade::{AMBIENT, DIRECT};
+use super::shade::{AMBIENT, DIRECT, to_display_rgba};
 use super::{TileContext, TileOut};
 
 impl TileContext<'_> {
-    /// The colours of a block's primary rays `rays` and their hits (a `width x height` layer), when every hit
-    /// is on a plain surface ([`is_plain`]) and the frame's shadows are hard or off; `None` otherwise, and
-    /// the caller shades the layer hit by hit (`shade_layer`). The same colours either way; this way
-    /// Sponza's hard-shadow MFT frame takes 9% fewer instructions (docs/BENCHMARKS.md, session 54).
+    /// Shades a block's primary rays `rays` and their hits (a `width x height` layer, pixel `i` at image
+    /// position `pixels[i]`) into the tile `out` and returns true, when every hit is on a plain surface
+    /// ([`is_plain`]) and the frame's shadows are hard or off; returns false otherwise, and the caller shades
+    /// the layer hit by hit (`shade_layer`). The same pixels either way; this way Sponza's hard-shadow MFT
+    /// frame takes 10% fewer instructions (docs/BENCHMARKS.md, session 54).
     pub(super) fn shade_plain(
         &self,
+        pixels: &[(u32, u32)],
         rays: &[Option<Ray>],
         hits: &[Option<Hit>],
         (width, height): (usize, usize),
         out: &mut TileOut,
         sc: &mut PlainScratch,
-    ) -> Option<Vec<Vec3>> {
+    ) -> bool {
         let segments = match self.settings.shadows {
             Shadows::Hard => true,
             Shadows::None => false,
-            _ => return None,
+            _ => return false,
         };
         let check = match self.plain {
             PlainMaterials::All => false,
             PlainMaterials::Some => true,
-            PlainMaterials::None => return None,
+            PlainMaterials::None => return false,
         };
         let scene = self.scene;
         let backend = self.tracer.options.backend;
@@ -52,7 +54,7 @@ impl TileContext<'_> {
         let epsilon = self.epsilon;
         let plain = Surfaces { scene, rays, hits, light, epsilon, segments, check, sc: &mut *sc };
         if !raylab_simd::dispatch(backend, plain) {
-            return None;
+            return false;
         }
         let mut shading = t0.elapsed().as_secs_f64();
         if segments {
@@ -68,10 +70,15 @@ impl TileContext<'_> {
             sc.set_visible_where_hit(hits);
         }
         let t1 = Instant::now();
-        let colours = raylab_simd::dispatch(backend, Colours { hits, light: &self.light, sc });
+        raylab_simd::dispatch(backend, Colours { n: hits.len(), light: &self.light, sc: &mut *sc });
+        let [r, g, b] = &sc.colour;
+        for (i, &p) in pixels.iter().enumerate() {
+            let k = out.index(p);
+            out.rgba[k] = to_display_rgba(Vec3::new(r[i], g[i], b[i]));
+        }
         shading += t1.elapsed().as_secs_f64();
         out.stages.shading += shading;
-        Some(colours)
+        true
     }
 }
 
@@ -115,6 +122,8 @@ pub(super) struct PlainScratch {
     albedo: [Vec<f32>; 3],
     /// Per pixel, how much of the light reaches it (0 or 1).
     visible: Vec<f32>,
+    /// Linear colours, one buffer per channel: black where there is no hit.
+    colour: [Vec<f32>; 3],
     /// The shadow segments to the light (`None` where there is no hit or it faces away).
     rays: Vec<Option<Ray>>,
     /// Their occlusion.
@@ -125,7 +134,7 @@ impl PlainScratch {
     /// Sizes the buffers for `n` pixels, padded to whole vectors of the widest backend.
     fn reset(&mut self, n: usize) {
         let padded = n.div_ceil(MAX_LANES) * MAX_LANES;
-        for b in self.point.iter_mut().chain(&mut self.normal).chain(&mut self.albedo) {
+        for b in self.point.iter_mut().chain(&mut self.normal).chain(&mut self.albedo).chain(&mut self.colour) {
             b.clear();
             b.resize(padded, 0.0);
         }
@@ -182,7 +191,7 @@ impl Kernel for Surfaces<'_> {
         for base in (0..rays.len()).step_by(V::LANES) {
             let mut present = 0u32;
             for i in 0..V::LANES.min(rays.len() - base) {
-                let (Some(r), Some(h)) = (rays[base + i], hits[base + i]) else { continue };
+                let (Some(r), Some(h)) = (&rays[base + i], &hits[base + i]) else { continue };
                 present |= 1 << i;
                 let tri = &scene.triangles[h.tri as usize];
                 let material = &scene.materials[tri.material as usize];
@@ -230,14 +239,15 @@ impl Kernel for Surfaces<'_> {
             let behind = dot(&normal, &geometric).lt(zero);
             let normal = map3([0, 1, 2], |k| V::select(behind, negate(normal[k]), normal[k]));
             let point = map3([0, 1, 2], |k| org[k] + dir[k] * t);
+            // Lanes without a hit get no albedo, so their colour is black whatever their stale values.
+            let hit = V::Mask::from_bits(present);
             for k in 0..3 {
                 point[k].write_to(&mut sc.point[k][base..base + V::LANES]);
                 normal[k].write_to(&mut sc.normal[k][base..base + V::LANES]);
-                quantity::<V>(&lanes, 12 + k).write_to(&mut sc.albedo[k][base..base + V::LANES]);
+                V::select(hit, quantity::<V>(&lanes, 12 + k), zero).write_to(&mut sc.albedo[k][base..base + V::LANES]);
             }
             if segments {
-                let lit = V::Mask::from_bits(present);
-                write_segments(&point, &geometric, &normal, light, epsilon, lit, &mut sc.rays[base..]);
+                write_segments(&point, &geometric, &normal, light, epsilon, hit, &mut sc.rays[base..]);
             }
         }
         true
@@ -279,25 +289,24 @@ fn write_segments<V: Vf32>(
     }
 }
 
-/// The colours of a layer's plain surfaces (from [`Surfaces`]) lit by `light` with the scratch's
-/// visibility: `albedo * (ambient + direct * N.L * attenuation * visibility)` as [`Surface::local`]
-/// computes it for a diffuse material; black where there is no hit.
+/// The colours of a layer's `n` plain surfaces (from [`Surfaces`]) lit by `light` with the scratch's
+/// visibility, into the scratch's colour buffers: `albedo * (ambient + direct * N.L * attenuation *
+/// visibility)` as [`Surface::local`] computes it for a diffuse material; black where there is no hit (no
+/// albedo there).
 ///
 /// [`Surface::local`]: super::shade::Surface::local
 struct Colours<'a> {
-    hits: &'a [Option<Hit>],
+    n: usize,
     light: &'a PointLight,
-    sc: &'a PlainScratch,
+    sc: &'a mut PlainScratch,
 }
 
 impl Kernel for Colours<'_> {
-    type Output = Vec<Vec3>;
+    type Output = ();
 
     #[inline(always)]
-    fn run<V: Vf32>(self) -> Vec<Vec3> {
-        let Colours { hits, light, sc } = self;
-        let n = hits.len();
-        let mut colours = vec![Vec3::ZERO; n];
+    fn run<V: Vf32>(self) {
+        let Colours { n, light, sc } = self;
         let (zero, one) = (V::splat(0.0), V::splat(1.0));
         let lp = [V::splat(light.position.x), V::splat(light.position.y), V::splat(light.position.z)];
         let (c0, c1, c2) = (V::splat(light.constant), V::splat(light.linear), V::splat(light.quadratic));
@@ -316,18 +325,11 @@ impl Kernel for Colours<'_> {
             let attenuation = V::select(denom.gt(one), one / denom, one);
             let lit = load::<V>(&sc.visible, base) * attenuation;
             let direct = V::splat(DIRECT) * (ndl * lit);
-            let mut rows = [[0.0f32; MAX_LANES]; 3];
-            for (k, row) in rows.iter_mut().enumerate() {
+            for k in 0..3 {
                 let c = load::<V>(&sc.albedo[k], base) * (V::splat(AMBIENT) + direct * V::splat(light.color[k]));
-                c.write_to(&mut row[..V::LANES]);
-            }
-            for (i, (o, h)) in colours[base..].iter_mut().zip(&hits[base..]).take(V::LANES).enumerate() {
-                if h.is_some() {
-                    *o = Vec3::new(rows[0][i], rows[1][i], rows[2][i]);
-                }
+                c.write_to(&mut sc.colour[k][base..base + V::LANES]);
             }
         }
-        colours
     }
 }
 
@@ -422,7 +424,8 @@ mod tests {
     }
 
     /// The plain path's shadow segments and colours are the per-hit path's (`Surface::at`, `shadow_ray`,
-    /// `Surface::local`) to the bit, on every backend, with and without vertex normals: hits from both
+    /// `Surface::local`) to the bit, on every backend, with and without vertex normals (and black where there
+    /// is no hit, whatever the lane held before): hits from both
     /// sides, a vanishing interpolated normal, a hit at the light itself, surfaces facing away from the
     /// light, missing rays and hits, and a layer that is not a whole number of vectors.
     #[test]
@@ -491,9 +494,10 @@ mod tests {
                 }
                 sc.blocked = blocked.clone();
                 sc.set_visible_from_blocked();
-                let got = dispatch(backend, Colours { hits, light: &light, sc: &sc });
-                let got: Vec<[u32; 3]> = got.iter().map(|c| c.to_array().map(f32::to_bits)).collect();
-                assert_eq!(got, colours, "{backend:?}, normals {normals}: colours");
+                dispatch(backend, Colours { n: hits.len(), light: &light, sc: &mut sc });
+                let got: Vec<[u32; 3]> =
+                    (0..hits.len()).map(|i| [0, 1, 2].map(|k| sc.colour[k][i].to_bits())).collect();
+                assert_eq!(got, colours, "{backend:?}, normals {normals}: colours, black (+0) without a hit");
                 // One hit on the specular triangle sends the layer down the per-hit path.
                 let mut mixed = hits.clone();
                 mixed[20] = mixed[20].map(|h| Hit { tri: plain_tris, ..h });
