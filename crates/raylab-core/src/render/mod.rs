@@ -342,7 +342,7 @@ impl TileContext<'_> {
 
         let colors = match settings.view {
             FrameView::Normals | FrameView::Depth => Vec::new(),
-            _ if self.shade_plain(&sc.pixels, &sc.rays, &sc.hits, (rw, rh), out, &mut sc.plain) => return,
+            _ if self.shade_plain((rw, rh), out, sc) => return,
             _ => {
                 sc.seeds.clear();
                 sc.seeds.extend(sc.pixels.iter().map(|&(x, y)| y * self.width + x));

@@ -20,58 +20,47 @@ use crate::scene::{Material, MaterialKind, PointLight, Scene};
 use crate::shadow::Shadows;
 
 use super::shade::{AMBIENT, DIRECT, to_display_rgba};
-use super::{TileContext, TileOut};
+use super::{Scratch, TileContext, TileOut};
 
 impl TileContext<'_> {
-    /// Shades a block's primary rays `rays` and their hits (a `width x height` layer, pixel `i` at image
-    /// position `pixels[i]`) into the tile `out` and returns true, when every hit is on a plain surface
-    /// ([`is_plain`]) and the frame's shadows are hard or off; returns false otherwise, and the caller shades
-    /// the layer hit by hit (`shade_layer`). The same pixels either way; this way Sponza's hard-shadow MFT
-    /// frame takes 10% fewer instructions (docs/BENCHMARKS.md, session 54).
-    pub(super) fn shade_plain(
-        &self,
-        pixels: &[(u32, u32)],
-        rays: &[Option<Ray>],
-        hits: &[Option<Hit>],
-        (width, height): (usize, usize),
-        out: &mut TileOut,
-        sc: &mut PlainScratch,
-    ) -> bool {
+    /// Shades a block's primary rays and their hits (`sc.rays`, `sc.hits`: a `width x height` layer, pixel
+    /// `i` at image position `sc.pixels[i]`) into the tile `out` and returns true, when every hit is on a
+    /// plain surface ([`is_plain`]) and the frame's shadows trace one segment per point to the light's
+    /// centre (hard, cached, edge widths; `ShadowTracer::segment_visibility`) or are off; returns false
+    /// otherwise, and the caller shades the layer hit by hit (`shade_layer`). The same pixels either way;
+    /// this way Sponza's hard-shadow MFT frame takes 13% fewer instructions (docs/BENCHMARKS.md, session 54).
+    pub(super) fn shade_plain(&self, dims: (usize, usize), out: &mut TileOut, sc: &mut Scratch) -> bool {
         let segments = match self.settings.shadows {
-            Shadows::Hard => true,
             Shadows::None => false,
-            _ => return false,
+            Shadows::MultiSample { .. } => return false,
+            Shadows::Hard | Shadows::Cached | Shadows::EdgeWidth { .. } => true,
         };
         let check = match self.plain {
             PlainMaterials::All => false,
             PlainMaterials::Some => true,
             PlainMaterials::None => return false,
         };
-        let scene = self.scene;
-        let backend = self.tracer.options.backend;
-        let light = self.light.position;
+        let Scratch { pixels, rays, hits, plain, shadow, .. } = sc;
+        let (scene, backend) = (self.scene, self.tracer.options.backend);
+        let (light, epsilon) = (self.light.position, self.epsilon);
         let t0 = Instant::now();
-        let epsilon = self.epsilon;
-        let plain = Surfaces { scene, rays, hits, light, epsilon, segments, check, sc: &mut *sc };
-        if !raylab_simd::dispatch(backend, plain) {
+        let segments = segments.then_some(&mut shadow.rays);
+        let kernel = Surfaces { scene, rays, hits, light, epsilon, segments, check, sc: &mut *plain };
+        if !raylab_simd::dispatch(backend, kernel) {
             return false;
         }
         let mut shading = t0.elapsed().as_secs_f64();
-        if segments {
-            let t = Instant::now();
-            sc.blocked.clear();
-            sc.blocked.resize(sc.rays.len(), false);
-            if sc.rays.iter().any(Option::is_some) {
-                self.tracer.occluded_tile(&sc.rays, width, height, Some(light), &mut sc.blocked, &mut out.stats);
-            }
-            sc.set_visible_from_blocked();
-            out.stages.shadow += t.elapsed().as_secs_f64();
+        if self.settings.shadows == Shadows::None {
+            plain.set_visible_where_hit(hits);
         } else {
-            sc.set_visible_where_hit(hits);
+            let t = Instant::now();
+            let visible = self.shadows().segment_visibility(dims, &mut out.stats, shadow);
+            plain.visible[..visible.len()].copy_from_slice(&visible);
+            out.stages.shadow += t.elapsed().as_secs_f64();
         }
         let t1 = Instant::now();
-        raylab_simd::dispatch(backend, Colours { n: hits.len(), light: &self.light, sc: &mut *sc });
-        let [r, g, b] = &sc.colour;
+        raylab_simd::dispatch(backend, Colours { n: hits.len(), light: &self.light, sc: &mut *plain });
+        let [r, g, b] = &plain.colour;
         for (i, &p) in pixels.iter().enumerate() {
             let k = out.index(p);
             out.rgba[k] = to_display_rgba(Vec3::new(r[i], g[i], b[i]));
@@ -124,10 +113,6 @@ pub(super) struct PlainScratch {
     visible: Vec<f32>,
     /// Linear colours, one buffer per channel: black where there is no hit.
     colour: [Vec<f32>; 3],
-    /// The shadow segments to the light (`None` where there is no hit or it faces away).
-    rays: Vec<Option<Ray>>,
-    /// Their occlusion.
-    blocked: Vec<bool>,
 }
 
 impl PlainScratch {
@@ -140,16 +125,6 @@ impl PlainScratch {
         }
         self.visible.clear();
         self.visible.resize(padded, 0.0);
-        self.rays.clear();
-        self.rays.resize(n, None);
-    }
-
-    /// How much of the light each pixel sees: 1 where its segment reached the light, 0 where it was
-    /// blocked, faces away, or has no hit.
-    fn set_visible_from_blocked(&mut self) {
-        for ((v, r), &b) in self.visible.iter_mut().zip(&self.rays).zip(&self.blocked) {
-            *v = if r.is_some() && !b { 1.0 } else { 0.0 };
-        }
     }
 
     /// Every pixel with a hit sees the whole light (shadows off).
@@ -161,14 +136,15 @@ impl PlainScratch {
 }
 
 /// The surfaces of a layer's hits (`rays[i]` hit `hits[i]`, all plain), written into the scratch buffers,
-/// and, when `segments` is set, each surface's shadow segment to the light's centre.
+/// and, into `segments` when it is given, each surface's shadow segment to the light's centre (`None`
+/// where there is no hit or the surface faces away from the light).
 struct Surfaces<'a> {
     scene: &'a Scene,
     rays: &'a [Option<Ray>],
     hits: &'a [Option<Hit>],
     light: Vec3,
     epsilon: f32,
-    segments: bool,
+    segments: Option<&'a mut Vec<Option<Ray>>>,
     /// Whether to check each hit's material (some of the scene's are not plain).
     check: bool,
     sc: &'a mut PlainScratch,
@@ -180,8 +156,12 @@ impl Kernel for Surfaces<'_> {
 
     #[inline(always)]
     fn run<V: Vf32>(self) -> bool {
-        let Surfaces { scene, rays, hits, light, epsilon, segments, check, sc } = self;
+        let Surfaces { scene, rays, hits, light, epsilon, mut segments, check, sc } = self;
         sc.reset(rays.len());
+        if let Some(out) = segments.as_deref_mut() {
+            out.clear();
+            out.resize(rays.len(), None);
+        }
         let (zero, one) = (V::splat(0.0), V::splat(1.0));
         let interpolate = !scene.normals.is_empty();
         // Each lane's ray and hit, and the triangle's face normal, material colour and vertex normals:
@@ -246,8 +226,8 @@ impl Kernel for Surfaces<'_> {
                 normal[k].write_to(&mut sc.normal[k][base..base + V::LANES]);
                 V::select(hit, quantity::<V>(&lanes, 12 + k), zero).write_to(&mut sc.albedo[k][base..base + V::LANES]);
             }
-            if segments {
-                write_segments(&point, &geometric, &normal, light, epsilon, hit, &mut sc.rays[base..]);
+            if let Some(out) = segments.as_deref_mut() {
+                write_segments(&point, &geometric, &normal, light, epsilon, hit, &mut out[base..]);
             }
         }
         true
@@ -462,22 +442,23 @@ mod tests {
                 rays.push(ray);
                 hits.push(hit);
             }
-            let blocked: Vec<bool> = (0..rays.len()).map(|i| i % 4 == 1).collect();
+
             let surfaces: Vec<Option<Surface>> =
                 rays.iter().zip(&hits).map(|(r, h)| Some(Surface::at(&scene, r.as_ref()?, h.as_ref()?))).collect();
             let segments: Vec<Option<Ray>> =
                 surfaces.iter().map(|s| shadow_ray(s.as_ref()?, light.position, light.position, epsilon)).collect();
             assert!(segments.iter().filter(|s| s.is_some()).count() > 10, "some surfaces face the light");
             assert!(segments.iter().zip(&hits).filter(|(s, h)| s.is_none() && h.is_some()).count() > 3);
+            // Blocked, lit, and partly lit (edge widths) points.
+            let visible: Vec<f32> = (0..rays.len())
+                .map(|i| if segments[i].is_some() { [1.0, 0.0, 0.25, 0.7][i % 4] } else { 0.0 })
+                .collect();
             let colours: Vec<[u32; 3]> = surfaces
                 .iter()
                 .zip(&rays)
                 .enumerate()
                 .map(|(i, (s, r))| match (s, r) {
-                    (Some(s), Some(r)) => {
-                        let visible = if segments[i].is_some() && !blocked[i] { 1.0 } else { 0.0 };
-                        s.local(r.dir, &light, visible).to_array().map(f32::to_bits)
-                    }
+                    (Some(s), Some(r)) => s.local(r.dir, &light, visible[i]).to_array().map(f32::to_bits),
                     _ => [0; 3],
                 })
                 .collect();
@@ -486,14 +467,14 @@ mod tests {
                 let (rays, hits) = (&rays, &hits);
                 // Checked hit by hit (the scene has a specular material too) or not: every hit here is plain.
                 for check in [true, false] {
-                    let light = light.position;
+                    let (light, mut out) = (light.position, Vec::new());
+                    let segs = Some(&mut out);
                     let kernel =
-                        Surfaces { scene: &scene, rays, hits, light, epsilon, segments: true, check, sc: &mut sc };
+                        Surfaces { scene: &scene, rays, hits, light, epsilon, segments: segs, check, sc: &mut sc };
                     assert!(dispatch(backend, kernel), "{backend:?}: every surface is plain");
-                    assert_eq!(sc.rays, segments, "{backend:?}, normals {normals}, check {check}: shadow segments");
+                    assert_eq!(out, segments, "{backend:?}, normals {normals}, check {check}: shadow segments");
                 }
-                sc.blocked = blocked.clone();
-                sc.set_visible_from_blocked();
+                sc.visible[..visible.len()].copy_from_slice(&visible);
                 dispatch(backend, Colours { n: hits.len(), light: &light, sc: &mut sc });
                 let got: Vec<[u32; 3]> =
                     (0..hits.len()).map(|i| [0, 1, 2].map(|k| sc.colour[k][i].to_bits())).collect();
@@ -507,7 +488,7 @@ mod tests {
                     hits: &mixed,
                     light: light.position,
                     epsilon,
-                    segments: true,
+                    segments: None,
                     check: true,
                     sc: &mut sc,
                 };

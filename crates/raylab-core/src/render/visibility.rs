@@ -29,7 +29,7 @@ pub struct ShadowScratch {
     cache: ShadowCache,
     edge: Vec<EdgeWidth>,
     samples: LightSamples,
-    rays: Vec<Option<Ray>>,
+    pub(super) rays: Vec<Option<Ray>>,
     /// Where each point's rays start in `rays`, and how many there are (`None`: no point, or it faces away).
     starts: Vec<Option<(usize, usize)>>,
     blocked: Vec<bool>,
@@ -89,23 +89,6 @@ impl ShadowTracer<'_> {
         sc.rays.extend(surfaces.iter().map(|s| s.as_ref().and_then(|s| shadow_ray(s, center, center, self.epsilon))));
     }
 
-    /// Hard shadows of a layer: fills `sc.rays` with the segments to the light's centre
-    /// ([`Self::segments_to_center`]) and `sc.blocked` with their occlusion, traced by the frame's method.
-    fn hard(
-        &self,
-        surfaces: &[Option<Surface>],
-        (width, height): (usize, usize),
-        stats: &mut TraversalStats,
-        sc: &mut ShadowScratch,
-    ) {
-        self.segments_to_center(surfaces, sc);
-        sc.blocked.clear();
-        sc.blocked.resize(sc.rays.len(), false);
-        if sc.rays.iter().any(Option::is_some) {
-            self.tracer.occluded_tile(&sc.rays, width, height, Some(self.light.position), &mut sc.blocked, stats);
-        }
-    }
-
     /// The visibility of the light from the hit `hit` of `ray` alone; `seed` jitters light samples.
     pub fn at_hit(&self, scene: &Scene, ray: &Ray, hit: &Hit, seed: u32, stats: &mut TraversalStats) -> f32 {
         let surface = [Some(Surface::at(scene, ray, hit))];
@@ -122,35 +105,62 @@ impl ShadowTracer<'_> {
         stats: &mut TraversalStats,
         sc: &mut ShadowScratch,
     ) -> Vec<f32> {
-        let light = &self.light;
-        let center = light.position;
-        let eps = self.epsilon;
-        let to_center = |s: &Surface| shadow_ray(s, center, center, eps);
         match self.shadows {
             Shadows::None => surfaces.iter().map(|s| if s.is_some() { 1.0 } else { 0.0 }).collect(),
+            Shadows::Hard | Shadows::Cached | Shadows::EdgeWidth { .. } => {
+                self.segments_to_center(surfaces, sc);
+                self.segment_visibility((width, height), stats, sc)
+            }
+            Shadows::MultiSample { samples, bound } => {
+                let mut out = Vec::with_capacity(surfaces.len());
+                let kernel = MultiSampled { st: self, surfaces, seeds, samples, bound, stats, sc, out: &mut out };
+                if self.tracer.options.method == Method::Reference {
+                    kernel.trace_with(&mut ReferenceBundles { tracer: self.tracer });
+                } else {
+                    raylab_simd::dispatch(self.tracer.options.backend, kernel);
+                }
+                out
+            }
+        }
+    }
+
+    /// The visibility in `[0, 1]` of the light along the segments in `sc.rays`, a `width x height` layer of
+    /// segments from the surfaces to the light's centre (`None`: no surface, or it faces away; it sees
+    /// nothing), under the techniques that trace those segments: hard shadows (by the frame's method), the
+    /// shadow cache and edge widths. Under the others, whose visibility these segments do not give, every
+    /// segment sees the whole light. The plain shading path builds the segments itself
+    /// (`super::plain`), so the two paths share this.
+    pub(super) fn segment_visibility(
+        &self,
+        (width, height): (usize, usize),
+        stats: &mut TraversalStats,
+        sc: &mut ShadowScratch,
+    ) -> Vec<f32> {
+        let center = self.light.position;
+        let seen = |r: &Option<Ray>, blocked: bool| if r.is_some() && !blocked { 1.0 } else { 0.0 };
+        match self.shadows {
             Shadows::Hard => {
-                self.hard(surfaces, (width, height), stats, sc);
-                sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| if r.is_some() && !b { 1.0 } else { 0.0 }).collect()
+                sc.blocked.clear();
+                sc.blocked.resize(sc.rays.len(), false);
+                if sc.rays.iter().any(Option::is_some) {
+                    self.tracer.occluded_tile(&sc.rays, width, height, Some(center), &mut sc.blocked, stats);
+                }
+                sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| seen(r, b)).collect()
             }
             Shadows::Cached if self.tracer.options.method.uses_dacrt() => {
-                self.segments_to_center(surfaces, sc);
                 sc.blocked.clear();
                 sc.blocked.resize(sc.rays.len(), false);
                 sc.cache.occluded_set(self.tracer, &sc.rays, &mut sc.blocked, stats);
-                sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| if r.is_some() && !b { 1.0 } else { 0.0 }).collect()
+                sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| seen(r, b)).collect()
             }
-            Shadows::Cached => surfaces
-                .iter()
-                .map(|s| match s.as_ref().and_then(to_center) {
-                    Some(r) if !sc.cache.occluded(self.tracer, &r, stats) => 1.0,
-                    _ => 0.0,
-                })
-                .collect(),
+            Shadows::Cached => {
+                let (cache, rays) = (&mut sc.cache, &sc.rays);
+                rays.iter().map(|r| seen(r, r.is_some_and(|r| cache.occluded(self.tracer, &r, stats)))).collect()
+            }
             Shadows::EdgeWidth { radius, leak_fix } => {
                 // Every segment walks the tree: one that nothing blocks finds no crossing and sees the whole
                 // light. A hard-shadow pass first, to walk only the blocked ones, cost more than it saved
                 // (docs/BENCHMARKS.md, shading readings).
-                self.segments_to_center(surfaces, sc);
                 // Scratch outlives frames (see `render`), whose edge settings may differ.
                 if sc.edge.first().is_none_or(|e| e.settings() != (radius, leak_fix)) {
                     sc.edge.clear();
@@ -169,16 +179,7 @@ impl ShadowTracer<'_> {
                 }
                 visible
             }
-            Shadows::MultiSample { samples, bound } => {
-                let mut out = Vec::with_capacity(surfaces.len());
-                let kernel = MultiSampled { st: self, surfaces, seeds, samples, bound, stats, sc, out: &mut out };
-                if self.tracer.options.method == Method::Reference {
-                    kernel.trace_with(&mut ReferenceBundles { tracer: self.tracer });
-                } else {
-                    raylab_simd::dispatch(self.tracer.options.backend, kernel);
-                }
-                out
-            }
+            Shadows::None | Shadows::MultiSample { .. } => sc.rays.iter().map(|r| seen(r, false)).collect(),
         }
     }
 }
