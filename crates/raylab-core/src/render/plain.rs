@@ -1,7 +1,8 @@
 //! Shading a layer of plain surfaces a vector of hits at a time: where every hit of a block is diffuse and
-//! untextured and the frame's shadows are hard or off (the thesis's benchmark shading, 4.2.1: one point
-//! light, Lambert, no secondary rays), the surfaces, their shadow segments and their colours are computed
-//! in structure-of-arrays form with the backend's vectors instead of hit by hit.
+//! untextured (the thesis's benchmark shading, 4.2.1: one point light, Lambert, no secondary rays) and the
+//! frame's shadows come from one segment per point to the light's centre (hard shadows, the shadow cache,
+//! edge widths) or are off, the surfaces, their shadow segments and their colours are computed in
+//! structure-of-arrays form with the backend's vectors instead of hit by hit.
 //!
 //! Every lane performs the operations of [`Surface::at`](super::shade::Surface::at),
 //! [`shadow_ray`](super::shade::shadow_ray) and [`Surface::local`](super::shade::Surface::local) in their
@@ -109,7 +110,7 @@ pub(super) struct PlainScratch {
     normal: [Vec<f32>; 3],
     /// Albedo (the material's base colour).
     albedo: [Vec<f32>; 3],
-    /// Per pixel, how much of the light reaches it (0 or 1).
+    /// Per pixel, how much of the light reaches it, in `[0, 1]`.
     visible: Vec<f32>,
     /// Linear colours, one buffer per channel: black where there is no hit.
     colour: [Vec<f32>; 3],
