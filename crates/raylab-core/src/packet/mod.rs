@@ -261,3 +261,9 @@ impl<V: Vf32> PacketHits<V> {
 pub fn hit_reach_lanes<V: Vf32>(t: V) -> V {
     t.max(t * V::splat(1.0 + crate::ray::HIT_SLACK))
 }
+
+/// `a . b` per lane, summed in glam's order (`Vec3::dot`), so a lane's result is the scalar one to the bit.
+#[inline(always)]
+pub(crate) fn dot3<V: Vf32>(a: &[V; 3], b: &[V; 3]) -> V {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}

@@ -15,7 +15,7 @@ use std::time::Instant;
 use glam::Vec3;
 use raylab_simd::{Kernel, VMask, Vf32};
 
-use crate::packet::{MAX_LANES, map3};
+use crate::packet::{MAX_LANES, dot3, map3};
 use crate::ray::{Hit, Ray};
 use crate::scene::{Material, MaterialKind, PointLight, Scene};
 use crate::shadow::Shadows;
@@ -31,7 +31,7 @@ impl TileContext<'_> {
     /// otherwise, and the caller shades the layer hit by hit (`shade_layer`). The same pixels either way;
     /// this way Sponza's hard-shadow MFT frame takes 13% fewer instructions (docs/BENCHMARKS.md, session 54).
     pub(super) fn shade_plain(&self, dims: (usize, usize), out: &mut TileOut, sc: &mut Scratch) -> bool {
-        let segments = match self.settings.shadows {
+        let shadowed = match self.settings.shadows {
             Shadows::None => false,
             Shadows::MultiSample { .. } => return false,
             Shadows::Hard | Shadows::Cached | Shadows::EdgeWidth { .. } => true,
@@ -45,19 +45,19 @@ impl TileContext<'_> {
         let (scene, backend) = (self.scene, self.tracer.options.backend);
         let (light, epsilon) = (self.light.position, self.epsilon);
         let t0 = Instant::now();
-        let segments = segments.then_some(&mut shadow.rays);
+        let segments = shadowed.then_some(&mut shadow.rays);
         let kernel = Surfaces { scene, rays, hits, light, epsilon, segments, check, sc: &mut *plain };
         if !raylab_simd::dispatch(backend, kernel) {
             return false;
         }
         let mut shading = t0.elapsed().as_secs_f64();
-        if self.settings.shadows == Shadows::None {
-            plain.set_visible_where_hit(hits);
-        } else {
+        if shadowed {
             let t = Instant::now();
             let visible = self.shadows().segment_visibility(dims, &mut out.stats, shadow);
             plain.visible[..visible.len()].copy_from_slice(&visible);
             out.stages.shadow += t.elapsed().as_secs_f64();
+        } else {
+            plain.set_visible_where_hit(hits);
         }
         let t1 = Instant::now();
         raylab_simd::dispatch(backend, Colours { n: hits.len(), light: &self.light, sc: &mut *plain });
@@ -200,7 +200,7 @@ impl Kernel for Surfaces<'_> {
             let [t, u, v] = quantity3::<V>(&lanes, 6);
             let face = quantity3::<V>(&lanes, 9);
             // Turned toward the side the ray came from (`Surface::at`).
-            let entering = dot(&face, &dir).lt(zero);
+            let entering = dot3(&face, &dir).lt(zero);
             let geometric = map3([0, 1, 2], |k| V::select(entering, face[k], negate(face[k])));
             // The interpolated normal, normalised, or the face normal where it vanishes
             // (`Scene::shading_normal`).
@@ -213,11 +213,11 @@ impl Kernel for Surfaces<'_> {
                     n0[1] * w + n1[1] * u + n2[1] * v,
                     n0[2] * w + n1[2] * u + n2[2] * v,
                 ];
-                let rcp = one / dot(&n, &n).sqrt();
+                let rcp = one / dot3(&n, &n).sqrt();
                 let usable = rcp.abs().lt(V::splat(f32::INFINITY)) & rcp.gt(zero);
                 normal = map3([0, 1, 2], |k| V::select(usable, n[k] * rcp, face[k]));
             }
-            let behind = dot(&normal, &geometric).lt(zero);
+            let behind = dot3(&normal, &geometric).lt(zero);
             let normal = map3([0, 1, 2], |k| V::select(behind, negate(normal[k]), normal[k]));
             let point = map3([0, 1, 2], |k| org[k] + dir[k] * t);
             // Lanes without a hit get no albedo, so their colour is black whatever their stale values.
@@ -250,11 +250,11 @@ fn write_segments<V: Vf32>(
 ) {
     let c = [V::splat(light.x), V::splat(light.y), V::splat(light.z)];
     let to_light = map3([0, 1, 2], |k| c[k] - point[k]);
-    let faces_away = (dot(normal, &to_light) * dot(normal, geometric)).le(V::splat(0.0));
+    let faces_away = (dot3(normal, &to_light) * dot3(normal, geometric)).le(V::splat(0.0));
     let eps = V::splat(epsilon);
     let q = map3([0, 1, 2], |k| point[k] + geometric[k] * eps);
     let v = map3([0, 1, 2], |k| c[k] - q[k]);
-    let d = dot(&v, &v).sqrt();
+    let d = dot3(&v, &v).sqrt();
     let dir = map3([0, 1, 2], |k| v[k] / d);
     let ok = lit & !faces_away & d.gt(V::splat(0.0)) & d.abs().lt(V::splat(f32::INFINITY));
     let bits = ok.bits();
@@ -296,10 +296,10 @@ impl Kernel for Colours<'_> {
             let normal =
                 [load::<V>(&sc.normal[0], base), load::<V>(&sc.normal[1], base), load::<V>(&sc.normal[2], base)];
             let to_light = map3([0, 1, 2], |k| lp[k] - point[k]);
-            let dist = dot(&to_light, &to_light).sqrt();
+            let dist = dot3(&to_light, &to_light).sqrt();
             let away = dist.gt(zero);
             let l = map3([0, 1, 2], |k| V::select(away, to_light[k] / dist, normal[k]));
-            let ndl = dot(&normal, &l);
+            let ndl = dot3(&normal, &l);
             // `f32::max(ndl, 0.0)`: NaN and negative cosines give 0.
             let ndl = V::select(ndl.gt(zero), ndl, zero);
             let denom = c0 + c1 * dist + c2 * dist * dist;
@@ -340,12 +340,6 @@ fn put(lanes: &mut [[f32; MAX_LANES]; QUANTITIES], i: usize, q: usize, x: Vec3) 
 #[inline(always)]
 fn load<V: Vf32>(b: &[f32], base: usize) -> V {
     V::from_slice(&b[base..base + V::LANES])
-}
-
-/// `a . b` per lane, summed in glam's order.
-#[inline(always)]
-fn dot<V: Vf32>(a: &[V; 3], b: &[V; 3]) -> V {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// `-x` per lane, exactly (a multiplication by -1 only flips the sign bit).

@@ -8,7 +8,7 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
 use super::Tracer;
-use crate::packet::{Cone, Frustum, PacketTile, RayPacket, SignBounds, map3};
+use crate::packet::{Cone, Frustum, PacketTile, RayPacket, SignBounds, dot3, map3};
 use crate::ray::Ray;
 
 /// Relative size of the gap between a shadow segment's end and the light beyond which the segments are not
@@ -268,12 +268,6 @@ pub(super) fn toward_frustum<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit
     let mut f = sides.frustum(toward, 0.0, t_max.reduce_max());
     widen_toward(&mut f.t_max, &mut f.origin_slack, toward, gap_max.reduce_max());
     Some(f)
-}
-
-/// `a . b` per lane, summed in glam's order.
-#[inline(always)]
-fn dot3<V: Vf32>(a: &[V; 3], b: &[V; 3]) -> V {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Each lane's segment seen from `tw` (a point in every lane), with [`toward_segments`]' operations: unit
