@@ -66,6 +66,10 @@ pub struct Cli {
     /// Render resolution in percent of the window, 25 to 100.
     #[arg(long, default_value_t = 100, value_parser = in_range(25, 100))]
     pub scale: u64,
+    /// Keep the render scale while the camera flies (by default frames traced while flying drop to the scale
+    /// that takes about 1/30 s, and the chosen scale returns once the camera is still).
+    #[arg(long)]
+    pub no_fly_scale: bool,
     /// Tracer threads (default: all CPUs).
     #[arg(long, value_parser = in_range(1, 1024))]
     pub threads: Option<u64>,

@@ -13,6 +13,7 @@ mod compare;
 mod compositor;
 mod cpu_clock;
 mod fly;
+mod fly_scale;
 mod frontend;
 mod gpu;
 mod headless;
@@ -75,6 +76,7 @@ fn run(cli: &Cli) -> Result<(), String> {
         show: cli.show,
         heat_max: cli.heat_max,
         scale: cli.scale as u32,
+        fly_scale: !cli.no_fly_scale,
         threads: cli.thread_count(),
         continuous: true,
         animate: cli.animate,

@@ -120,6 +120,9 @@ pub struct ViewerSettings {
     pub heat_max: Option<f32>,
     /// Render resolution in percent of the window (25-100).
     pub scale: u32,
+    /// Trace at a lower scale while the camera flies, when a frame at `scale` would miss the fly budget
+    /// ([`crate::fly_scale`]).
+    pub fly_scale: bool,
     /// Tracer threads.
     pub threads: usize,
     /// Keep tracing the same view (to read steady FPS) rather than only after a change.

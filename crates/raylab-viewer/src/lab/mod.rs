@@ -15,6 +15,7 @@ use raylab_core::scene::PointLight;
 
 use crate::camera_path::{CameraPath, Player, Recorder};
 use crate::fly::{FlyCamera, MoveKeys};
+use crate::fly_scale::{FLY_BUDGET, FlyScale, scale_for_budget};
 use crate::loader::{LoadPoll, LoadedScene, PendingLoad, TreeParams};
 use crate::settings::{RenderMode, ViewerSettings};
 use crate::worker::{Job, ReflectionJob, Rendered, Worker, WorkerEvent};
@@ -52,6 +53,8 @@ pub struct Lab {
     /// The settings the next frame is traced with.
     pub settings: ViewerSettings,
     fly: FlyCamera,
+    /// Whether the user is flying the camera, for the render scale while flying.
+    flying: FlyScale,
     light: PointLight,
     worker: Worker,
     wake: Arc<dyn Fn() + Send + Sync>,
@@ -121,6 +124,7 @@ impl Lab {
             kd,
             settings,
             fly,
+            flying: FlyScale::default(),
             light,
             worker,
             wake,
@@ -196,6 +200,7 @@ impl Lab {
     /// Turns the camera by a mouse motion in pixels.
     pub fn look(&mut self, dx: f32, dy: f32) {
         if self.player.is_none() && self.fly.look(dx, dy) {
+            self.flying.moved();
             self.dirty = true;
         }
     }
@@ -314,9 +319,15 @@ impl Lab {
         }
     }
 
-    /// Advances time by `dt` seconds: flies the camera with the held keys and records the path.
+    /// Advances time by `dt` seconds: flies the camera with the held keys, records the path, and asks for the
+    /// chosen render scale again once the camera has settled after flying.
     pub fn tick(&mut self, dt: f32) {
         if self.player.is_none() && self.fly.step(&self.keys, dt) {
+            self.flying.moved();
+            self.dirty = true;
+        }
+        if self.flying.settled() {
+            // The camera stopped: trace the view again at the chosen scale.
             self.dirty = true;
         }
         if let Some(r) = &mut self.recorder {
@@ -364,7 +375,8 @@ impl Lab {
 
     /// How soon the UI must be drawn again without any input or traced frame: at once while a movement
     /// key is held (the camera flies), soon while a load or a comparison shows its progress, when the oldest
-    /// message expires; `None` when nothing changes by itself. Traced frames wake the UI on their own.
+    /// message expires or when a frame traced at a lower scale while flying is to be traced again at the
+    /// chosen one; `None` when nothing changes by itself. Traced frames wake the UI on their own.
     pub fn next_redraw(&self) -> Option<Duration> {
         if self.keys.any() {
             return Some(Duration::ZERO);
@@ -376,7 +388,7 @@ impl Lab {
             return Some(HYBRID_POLL);
         }
         let message = self.messages.iter().map(|m| MESSAGE_TIME.saturating_sub(m.at.elapsed())).min();
-        message.into_iter().chain(self.readouts.refresh_due()).min()
+        message.into_iter().chain(self.readouts.refresh_due()).chain(self.flying.settle_in()).min()
     }
 
     fn poll_loading(&mut self) {
@@ -421,7 +433,7 @@ impl Lab {
             return None;
         }
         self.dirty = false;
-        let mut job = self.job();
+        let mut job = self.next_job();
         job.size = job.settings.hybrid.gbuffer_size(job.size.0, job.size.1);
         Some(job)
     }
@@ -450,7 +462,27 @@ impl Lab {
             return;
         }
         self.dirty = false;
-        self.worker.request(self.job());
+        let job = self.next_job();
+        self.worker.request(job);
+    }
+
+    /// The job for the next frame: [`Lab::job`], at a lower scale while the user flies the camera and a frame
+    /// at the chosen scale would take longer than the fly budget, as the latest frame's time per pixel
+    /// predicts ([`crate::fly_scale`]).
+    fn next_job(&mut self) -> Job {
+        let mut job = self.job();
+        let chosen = job.settings.scale;
+        if job.settings.fly_scale
+            && self.flying.flying()
+            && let Some(r) = &self.latest
+        {
+            let (w, h) = self.window;
+            let pixels = u64::from(r.frame.width) * u64::from(r.frame.height);
+            job.settings.scale = scale_for_budget(chosen, u64::from(w) * u64::from(h), pixels, r.wall_s, FLY_BUDGET);
+            job.size = job.settings.render_size(w, h);
+        }
+        self.flying.sent(job.settings.scale, chosen);
+        job
     }
 
     fn job(&self) -> Job {
@@ -589,6 +621,7 @@ mod tests {
             show: FrameView::Shaded,
             heat_max: None,
             scale: 100,
+            fly_scale: true,
             threads: 2,
             continuous: false,
             animate: false,
@@ -694,6 +727,33 @@ mod tests {
         for f in &frames[1..] {
             assert!(f.stats.rays > 0);
             assert_eq!(f.rgba, frames[0].rgba);
+        }
+    }
+
+    /// Frames traced while the user flies drop to the scale the fly budget allows, and the view is traced
+    /// again at the chosen scale once the camera settles; with the switch off the scale stays.
+    #[test]
+    fn flying_lowers_the_scale_until_the_camera_settles() {
+        for on in [true, false] {
+            let mut l = lab(Method::Mft);
+            l.settings.fly_scale = on;
+            l.set_window_size(64, 48);
+            wait(&mut l, |l| l.latest().is_some());
+            // As if the last full frame had taken a second: 25% is the most that fits 1/30 s.
+            l.latest.as_mut().unwrap().wall_s = 1.0;
+            l.look(4.0, 0.0);
+            let flown = if on { (16, 12) } else { (64, 48) };
+            wait(&mut l, |l| l.latest().is_some_and(|r| r.wall_s < 1.0) && !l.dirty);
+            let r = l.latest().unwrap();
+            assert_eq!((r.frame.width, r.frame.height), flown, "fly scale {on}");
+            assert_eq!(r.settings.scale, if on { 25 } else { 100 });
+            assert_eq!(l.flying.settle_in().is_some(), on, "a reduced frame asks to be traced again");
+            std::thread::sleep(crate::fly_scale::SETTLE);
+            l.tick(0.0);
+            wait(&mut l, |l| l.latest().is_some_and(|r| r.settings.scale == 100) && !l.dirty);
+            let f = &l.latest().unwrap().frame;
+            assert_eq!((f.width, f.height), (64, 48), "the chosen scale is back");
+            assert_eq!(l.flying.settle_in(), None);
         }
     }
 

@@ -166,6 +166,7 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
     let animation = lab.latest().and_then(|r| r.animation);
     let hybrid = lab.latest().and_then(|r| r.hybrid.clone());
     let gpu_ms = lab.hybrid_gpu_ms;
+    let traced_scale = lab.latest().map(|r| r.settings.scale);
     let s = &mut lab.settings;
     egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| {
         egui::ComboBox::from_label("mode").selected_text(value_name(&s.mode)).show_ui(ui, |ui| {
@@ -251,6 +252,15 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
         let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
         ui.add(egui::Slider::new(&mut s.threads, 1..=(2 * cpus).max(2)).text("threads"));
         ui.add(egui::Slider::new(&mut s.scale, 25..=100).text("render scale %"));
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut s.fly_scale, "lower while flying").on_hover_text(
+                "while the camera moves, trace at the scale that takes about 1/30 s a frame; \
+                 the chosen scale returns once it stops",
+            );
+            if let Some(t) = traced_scale.filter(|&t| t < s.scale) {
+                ui.label(format!("(now {t}%)"));
+            }
+        });
         ui.checkbox(&mut s.continuous, "trace continuously").on_hover_text("keep tracing a still view for steady FPS");
         ui.add_enabled(
             s.mode != RenderMode::Hybrid,
