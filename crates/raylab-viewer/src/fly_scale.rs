@@ -65,10 +65,12 @@ impl FlyScale {
         self.reduced && !self.flying()
     }
 
-    /// How soon [`FlyScale::settled`] may turn true without further input, while a reduced frame is shown.
+    /// How soon [`FlyScale::settled`] turns true without further input, while a reduced frame is shown and
+    /// the camera has not settled yet; `None` once it has (the view is then marked for tracing, and a UI
+    /// that cannot send the job yet, minimised or comparing methods, need not wake for it).
     pub fn settle_in(&self) -> Option<Duration> {
-        let t = self.last_motion.filter(|_| self.reduced)?;
-        Some(SETTLE.saturating_sub(t.elapsed()))
+        let left = SETTLE.checked_sub(self.last_motion.filter(|_| self.reduced)?.elapsed())?;
+        (!left.is_zero()).then_some(left)
     }
 }
 
@@ -113,7 +115,7 @@ mod tests {
         assert!(f.settle_in().is_some_and(|d| d <= SETTLE));
         std::thread::sleep(SETTLE + Duration::from_millis(20));
         assert!(!f.flying() && f.settled());
-        assert_eq!(f.settle_in(), Some(Duration::ZERO));
+        assert_eq!(f.settle_in(), None, "settled: nothing more to wait for");
         f.sent(100, 100);
         assert!(!f.settled() && f.settle_in().is_none(), "the full-scale frame was asked for");
     }
