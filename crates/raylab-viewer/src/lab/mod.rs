@@ -466,14 +466,15 @@ impl Lab {
         self.worker.request(job);
     }
 
-    /// The job for the next frame: [`Lab::job`], at a lower scale while the user flies the camera and a frame
-    /// at the chosen scale would take longer than the fly budget, as the latest frame's time per pixel
-    /// predicts ([`crate::fly_scale`]).
+    /// The job for the next frame: [`Lab::job`], at a lower scale while the user flies the camera (a played
+    /// camera path never) and a frame at the chosen scale would take longer than the fly budget, as the
+    /// latest frame's time per pixel predicts ([`crate::fly_scale`]).
     fn next_job(&mut self) -> Job {
         let mut job = self.job();
         let chosen = job.settings.scale;
         if job.settings.fly_scale
             && self.flying.flying()
+            && self.player.is_none()
             && let Some(r) = &self.latest
         {
             let (w, h) = self.window;
