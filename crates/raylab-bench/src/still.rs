@@ -10,7 +10,7 @@ use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::reference::BruteForce;
 use raylab_core::render::{Frame, RenderSettings, render};
-use raylab_core::scene::{PointLight, Scene};
+use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::trace::{TraceOptions, Tracer};
 
 use crate::args::SceneArgs;
@@ -22,6 +22,10 @@ pub struct Still {
     pub scene: Scene,
     /// Its kd-tree.
     pub tree: KdTree,
+    /// The camera the frame was rendered from (the scene's view with the flags' overrides).
+    pub camera: Camera,
+    /// The light it was lit by.
+    pub light: PointLight,
     /// The frame.
     pub frame: Frame,
     /// Seconds spent loading the scene.
@@ -81,7 +85,7 @@ pub fn render_still(
     timed.sort_by(|a, b| a.0.total_cmp(&b.0));
     let (render_s, stages) = timed[timed.len() / 2];
     frame.stages = stages;
-    Ok(Still { scene: loaded, tree, frame, load_s, render_s, frame_s })
+    Ok(Still { scene: loaded, tree, camera, light, frame, load_s, render_s, frame_s })
 }
 
 impl Still {

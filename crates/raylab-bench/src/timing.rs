@@ -224,15 +224,9 @@ pub fn measure(
         box_tests_per_ray: stats.box_tests as f64 / stats.rays.max(1) as f64,
         nodes_per_packet: stats.nodes_per_packet(),
         isects_per_packet: stats.isects_per_packet(),
-        culled_percent: culled_percent(&stats),
+        culled_percent: stats.culled_percent(),
     };
     Ok((report, results))
-}
-
-/// Culled packet visits as a share of packet visits to leaves (culled plus tested), in percent.
-fn culled_percent(s: &TraversalStats) -> f64 {
-    let tested = s.packets_culled + s.packets_tested;
-    if tested == 0 { 0.0 } else { 100.0 * s.packets_culled as f64 / tested as f64 }
 }
 
 /// Hit (or occluded) count and the sum of hit distances.

@@ -22,7 +22,8 @@ fn render_writes_a_png() {
     let img = image::open(&out).expect("a PNG").to_rgba8();
     assert_eq!(img.dimensions(), (64, 48));
     assert!(img.pixels().any(|p| p.0[0] > 40), "the image is not black");
-    assert!(String::from_utf8_lossy(&o.stdout).contains("wrote"));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("wrote") && stdout.contains("counters: "), "{stdout}");
 }
 
 #[test]
@@ -49,6 +50,41 @@ fn repeated_frames_report_their_times_and_keep_the_image() {
     assert!(min > 0.0 && min <= median && median <= max, "{line}");
     assert!(many.contains("stages (median frame, summed over threads)"), "{many}");
     assert_eq!(first, last, "every frame is the same image");
+}
+
+#[test]
+fn render_json_is_one_object_with_frame_times_stages_and_counters() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("j.png");
+    let args = ["render", "--scene", "arena", "--width", "40", "--height", "30", "--method", "mft", "--tile", "8"];
+    let rest = ["--shadows", "cached", "--depth", "1", "--frames", "3", "--threads", "2", "--json", "--out"];
+    let o = bench(&[&args[..], &rest, &[out.to_str().unwrap()]].concat(), dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is exactly one JSON object");
+    let f = |path: &str| v.pointer(path).and_then(serde_json::Value::as_f64).unwrap_or_else(|| panic!("{path}: {v}"));
+    assert_eq!(image::open(&out).expect("the PNG is still written").to_rgba8().dimensions(), (40, 30));
+    assert_eq!(v["out"].as_str().map(std::path::PathBuf::from), Some(out.canonicalize().unwrap()));
+    assert_eq!((v["frames"].as_u64(), v["frame_seconds"]["each"].as_array().map(Vec::len)), (Some(3), Some(3)));
+    let (median, min, max) = (f("/frame_seconds/median"), f("/frame_seconds/min"), f("/frame_seconds/max"));
+    assert!(0.0 < min && min <= median && median <= max, "{v}");
+    assert!((f("/fps") * median - 1.0).abs() < 1e-9, "FPS from the median frame: {v}");
+    assert!(f("/stages_seconds/primary") > 0.0 && f("/stages_seconds/shadow") > 0.0, "{v}");
+    assert_eq!(v["settings"]["shadows"]["technique"], "cached");
+    assert_eq!((v["settings"]["width"].as_u64(), v["settings"]["max_depth"].as_u64()), (Some(40), Some(1)));
+    assert_eq!(v["options"]["method"], "mft");
+    assert!(["avx512", "avx2", "sse2", "scalar"].contains(&v["options"]["backend"].as_str().unwrap()), "{v}");
+    // Primary rays, shadow rays and reflections: more rays than pixels, and the derived figures agree with the
+    // raw counters.
+    let rays = f("/counters/rays");
+    assert!(rays > 1200.0, "{v}");
+    // (JSON's decimal floats come back within an ulp or so.)
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+    assert!(close(f("/mrays_per_second"), rays / median / 1e6), "{v}");
+    assert!(close(f("/nodes_per_packet"), f("/counters/nodes") / f("/counters/packets")), "{v}");
+    assert!(close(f("/isects_per_packet"), f("/counters/isect_tests") / f("/counters/packets")), "{v}");
+    let visits = f("/counters/packets_culled") + f("/counters/packets_tested");
+    assert!(visits > 0.0 && close(f("/culled_percent"), 100.0 * f("/counters/packets_culled") / visits), "{v}");
+    assert!(f("/counters/cache_lookups") > 0.0 && (0.0..=1.0).contains(&f("/cache_hit_rate")), "{v}");
 }
 
 #[test]
@@ -446,6 +482,8 @@ fn compare_takes_turns_with_the_harness_and_reports_its_figures() {
             "mbvh-rs",
             "--rs-groups",
             "16",
+            "--json",
+            "compare.json",
         ],
         dir.path(),
     );
@@ -467,6 +505,31 @@ fn compare_takes_turns_with_the_harness_and_reports_its_figures() {
     );
     // Each invocation repeats the primary check; the table lists it once.
     assert_eq!(md.matches("256 primary rays").count(), 1, "{md}");
+
+    // The same comparison as JSON: each configuration beside the Embree row it is compared with.
+    let json = std::fs::read(dir.path().join("compare.json")).expect("--json writes its file");
+    let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+    let entries = |key: &str| v[key].as_array().unwrap_or_else(|| panic!("{key}: {v}")).clone();
+    let kind_of = |e: &serde_json::Value| e["report"]["kind"].as_str().unwrap().to_string();
+    assert_eq!(v["embree"]["rows"].as_array().map(Vec::len), Some(6), "{v}");
+    assert_eq!(v["embree"]["builds"][0]["seconds"], 0.123);
+    let mono = entries("mono");
+    assert_eq!(mono.iter().map(kind_of).collect::<Vec<_>>(), ["primary", "shadow", "diffuse"]);
+    for e in &mono {
+        let ours = e["report"]["mrays_median"].as_f64().unwrap();
+        let expected = ours / e["embree"]["median"].as_f64().unwrap();
+        assert!((e["ratio"].as_f64().unwrap() - expected).abs() < 1e-9 * expected, "{e}");
+    }
+    assert_eq!((&mono[1]["embree_api"], &mono[1]["embree"]["kind"]), (&"rtcOccluded1".into(), &"shadow_1".into()));
+    let coherent = entries("coherent");
+    assert_eq!(coherent.iter().map(kind_of).collect::<Vec<_>>(), ["primary", "shadow"]);
+    assert_eq!((&coherent[0]["method"], coherent[0]["tile"].as_u64()), (&"mft".into(), Some(4)));
+    assert_eq!(coherent[0]["embree_best"]["kind"], "primary_8_4x2");
+    assert_eq!(coherent[1]["embree_best"]["median"], 4.0);
+    assert!(coherent[1]["report"]["stats"]["packets"].as_u64().unwrap() > 0, "counters come with each report");
+    let incoherent = entries("incoherent");
+    assert_eq!((incoherent.len(), &incoherent[0]["method"]), (1, &"mbvh-rs (16)".into()));
+    assert_eq!(incoherent[0]["embree_intersect1m"]["median"], 0.8);
 }
 
 /// A harness whose primary single-ray figures change from one invocation to the next: medians 1.0, 3.0, then

@@ -101,6 +101,12 @@ impl TraversalStats {
     pub fn isects_per_packet(&self) -> f64 {
         ratio(self.isect_tests, self.packets)
     }
+
+    /// Packet visits to leaves that packet/leaf culling skipped, as a percentage of all packet visits to
+    /// leaves (culled plus tested; thesis Table 4.2); 0 when there were none.
+    pub fn culled_percent(&self) -> f64 {
+        100.0 * ratio(self.packets_culled, self.packets_culled + self.packets_tested)
+    }
 }
 
 fn ratio(a: u64, b: u64) -> f64 {
@@ -144,6 +150,8 @@ mod tests {
         assert_eq!(a.nodes_per_ray(), 3.0);
         assert_eq!(a.cache_hit_rate(), 0.25);
         assert_eq!(a.isects_per_ray(), 2.0);
+        assert_eq!(a.culled_percent(), 25.0, "one of four packet visits to leaves culled");
         assert_eq!(TraversalStats::default().nodes_per_ray(), 0.0);
+        assert_eq!(TraversalStats::default().culled_percent(), 0.0, "no visits, nothing culled");
     }
 }

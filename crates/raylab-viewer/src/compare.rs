@@ -57,7 +57,6 @@ pub fn measure(job: &Job, method: Method, tile: u32) -> CompareRow {
     runs.sort_by(|a, b| a.wall_s.total_cmp(&b.wall_s));
     let r = &runs[TIMED_FRAMES / 2];
     let s = r.frame.stats;
-    let visits = s.packets_culled + s.packets_tested;
     CompareRow {
         method,
         tile,
@@ -66,7 +65,7 @@ pub fn measure(job: &Job, method: Method, tile: u32) -> CompareRow {
         mrays: s.rays as f64 / r.wall_s.max(1e-9) / 1e6,
         n: s.nodes_per_packet(),
         i: s.isects_per_packet(),
-        culled_pct: if visits == 0 { 0.0 } else { 100.0 * s.packets_culled as f64 / visits as f64 },
+        culled_pct: s.culled_percent(),
     }
 }
 

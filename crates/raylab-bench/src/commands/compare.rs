@@ -18,6 +18,8 @@ use raylab_core::reference::BruteForce;
 use raylab_core::scene::Scene;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, Workload, WorkloadBuilder};
+use serde::Serialize;
+use serde_json::json;
 
 use crate::args::{ImageArgs, KdArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
@@ -70,13 +72,20 @@ pub struct CompareArgs {
     /// Also write the markdown to this file.
     #[arg(long)]
     markdown: Option<PathBuf>,
+    /// Also write the comparison as one JSON object to this file: the machine, the view, the harness's rows
+    /// and builds, and each raylab configuration's full report (counters included) beside the Embree row it is
+    /// compared with and the ratio.
+    #[arg(long)]
+    json: Option<PathBuf>,
 }
 
 /// Embree's numbers for one kind and thread count.
-#[derive(Clone)]
+#[derive(Clone, Serialize)]
 struct EmbreeRow {
+    /// The harness's name of the ray kind and API (`primary_1`, `shadow_8_4x2`, `diffuse_1M`, ...).
     kind: String,
     threads: u64,
+    /// Mrays/s: the median run (of the median round, with `--rounds`), the slowest and the fastest.
     median: f64,
     min: f64,
     max: f64,
@@ -111,6 +120,20 @@ impl EmbreeRun {
         }
     }
 
+    /// The row of harness kind `kind` at `threads` threads.
+    fn row(&self, kind: &str, threads: usize) -> Option<&EmbreeRow> {
+        self.rows.iter().find(|e| e.kind == kind && e.threads == threads as u64)
+    }
+
+    /// The fastest packet or stream API (not the single-ray one) for the primary or the shadow rays of `r`.
+    fn best_coherent(&self, r: &TraceReport) -> Option<&EmbreeRow> {
+        let prefix = if r.kind.is_occlusion() { "shadow_" } else { "primary_" };
+        self.rows
+            .iter()
+            .filter(|e| e.kind.starts_with(prefix) && !e.kind.ends_with("_1") && e.threads == r.threads as u64)
+            .max_by(|x, y| x.median.total_cmp(&y.median))
+    }
+
     /// Replaces each row's figures by those of its rounds ([`median_of_rounds`]).
     fn combine(&mut self, rounds: &[Vec<EmbreeRow>]) {
         for (row, all) in self.rows.iter_mut().zip(rounds) {
@@ -139,6 +162,20 @@ fn combine_reports(rounds: &[&TraceReport]) -> TraceReport {
     (r.mrays_median, r.mrays_min, r.mrays_max) =
         median_of_rounds(rounds.iter().map(|x| (x.mrays_median, x.mrays_min, x.mrays_max)));
     r
+}
+
+/// Embree's single-ray API for a ray kind, and the harness's name of its row.
+fn single_ray_api(kind: RayKind) -> (&'static str, &'static str) {
+    match kind {
+        RayKind::Primary => ("rtcIntersect1", "primary_1"),
+        RayKind::Shadow => ("rtcOccluded1", "shadow_1"),
+        RayKind::Diffuse => ("rtcIntersect1", "diffuse_1"),
+    }
+}
+
+/// raylab's median against an Embree row's, or `None` without the row.
+fn ratio(r: &TraceReport, e: Option<&EmbreeRow>) -> Option<f64> {
+    e.map(|e| r.mrays_median / e.median)
 }
 
 /// A report's checksum column: the occluded count, or the hits and their distances' sum.
@@ -293,12 +330,8 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     );
     let _ = writeln!(md, "|---|---:|---:|---|---:|---:|---|---:|---:|");
     for r in &ours {
-        let (api, ekind) = match r.kind {
-            RayKind::Primary => ("rtcIntersect1", "primary_1"),
-            RayKind::Shadow => ("rtcOccluded1", "shadow_1"),
-            RayKind::Diffuse => ("rtcIntersect1", "diffuse_1"),
-        };
-        let e = embree.rows.iter().find(|e| e.kind == ekind && e.threads == r.threads as u64);
+        let (api, ekind) = single_ray_api(r.kind);
+        let e = embree.row(ekind, r.threads);
         let (es, ratio) = match e {
             Some(e) => {
                 (format!("{:.2} ({:.2}-{:.2})", e.median, e.min, e.max), format!("{:.2}x", r.mrays_median / e.median))
@@ -350,12 +383,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         );
         let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|---|");
         for (method, tile, r) in &coherent {
-            let prefix = if r.kind.is_occlusion() { "shadow_" } else { "primary_" };
-            let best = embree
-                .rows
-                .iter()
-                .filter(|e| e.kind.starts_with(prefix) && !e.kind.ends_with("_1") && e.threads == r.threads as u64)
-                .max_by(|x, y| x.median.total_cmp(&y.median));
+            let best = embree.best_coherent(r);
             let (bname, bval, ratio) = match best {
                 Some(e) => (e.kind.clone(), format!("{:.2}", e.median), format!("{:.2}x", r.mrays_median / e.median)),
                 None => ("n/a".into(), "n/a".into(), "n/a".into()),
@@ -400,13 +428,9 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
         for (method, r) in &incoherent {
             let embree_of = |kind: &str| {
-                embree
-                    .rows
-                    .iter()
-                    .find(|e| e.kind == kind && e.threads == r.threads as u64)
-                    .map_or(("n/a".to_string(), "n/a".to_string()), |e| {
-                        (format!("{:.2}", e.median), format!("{:.2}x", r.mrays_median / e.median))
-                    })
+                embree.row(kind, r.threads).map_or(("n/a".to_string(), "n/a".to_string()), |e| {
+                    (format!("{:.2}", e.median), format!("{:.2}x", r.mrays_median / e.median))
+                })
             };
             let ((e1, r1), (em, rm)) = (embree_of("diffuse_1"), embree_of("diffuse_1M"));
             let _ = writeln!(
@@ -427,6 +451,43 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     print!("{md}");
     if let Some(p) = &a.markdown {
         std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
+    }
+    if let Some(p) = &a.json {
+        let v = json!({
+            "environment": env,
+            "command": cmd,
+            "scene": a.scene.scene,
+            "camera": cam,
+            "light": light.position.to_array(),
+            "width": w,
+            "height": h,
+            "reps": a.reps,
+            "rounds": a.rounds,
+            "embree": { "checks": embree.checks, "rows": embree.rows, "builds": embree.builds.iter()
+                .map(|&(threads, seconds)| json!({ "threads": threads, "seconds": seconds })).collect::<Vec<_>>() },
+            "builds": builds.iter().map(|&(threads, thesis, packets)| json!({
+                "threads": threads, "kd_seconds": thesis, "packet_kd_seconds": packets, "kd_params": params[0],
+                "packet_kd_params": params[1],
+            })).collect::<Vec<_>>(),
+            "mono": ours.iter().map(|r| {
+                let (api, ekind) = single_ray_api(r.kind);
+                let e = embree.row(ekind, r.threads);
+                json!({ "report": r, "embree_api": api, "embree": e, "ratio": ratio(r, e) })
+            }).collect::<Vec<_>>(),
+            "coherent": coherent.iter().map(|(method, tile, r)| {
+                let e = embree.best_coherent(r);
+                json!({ "method": method, "tile": tile, "report": r, "embree_best": e, "ratio": ratio(r, e) })
+            }).collect::<Vec<_>>(),
+            "incoherent": incoherent.iter().map(|(label, r)| {
+                let (single, stream) = (embree.row("diffuse_1", r.threads), embree.row("diffuse_1M", r.threads));
+                json!({ "method": label, "report": r, "embree_intersect1": single, "ratio_intersect1": ratio(r, single),
+                    "embree_intersect1m": stream, "ratio_intersect1m": ratio(r, stream) })
+            }).collect::<Vec<_>>(),
+            "mbvh_builds": mbvh_builds.iter().map(|&(threads, seconds)| json!({ "threads": threads, "seconds": seconds }))
+                .collect::<Vec<_>>(),
+            "dacrt_setup_seconds": dacrt_setup,
+        });
+        std::fs::write(p, format!("{v:#}\n")).map_err(|e| format!("--json: cannot write {}: {e}", p.display()))?;
     }
     Ok(())
 }

@@ -4,8 +4,11 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use raylab_bench::env::Environment;
 use raylab_bench::still::{Still, render_still};
 use raylab_core::render::{FrameView, RayOrder, RenderSettings};
+use raylab_core::scene::PointLight;
+use serde_json::json;
 
 use crate::args::{ImageArgs, KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_positive};
 
@@ -41,6 +44,10 @@ pub struct RenderArgs {
     /// shading cost of a viewer frame, without the window.
     #[arg(long, default_value_t = 1, value_parser = in_range(1, 100_000))]
     frames: u64,
+    /// Print one JSON object on stdout and nothing else: the machine, the view and settings, every frame's
+    /// time, the median frame's stages and the frame's counters (the PNG is still written).
+    #[arg(long)]
+    json: bool,
 }
 
 impl RenderArgs {
@@ -56,11 +63,10 @@ impl RenderArgs {
     }
 }
 
-/// Runs the command.
-pub fn run(a: &RenderArgs) -> Result<(), String> {
-    let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
+/// The frame settings of the flags, for the scene's `light` (the default edge-width radius is its radius).
+fn frame_settings(a: &RenderArgs, light: &PointLight) -> RenderSettings {
     let (width, height) = a.image.size();
-    let settings = |light: &_| RenderSettings {
+    RenderSettings {
         width,
         height,
         tile: a.m.tile as u32,
@@ -69,13 +75,51 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         max_depth: a.shade.depth as u32,
         view: a.show,
         heat_max: a.heat_max,
-    };
+    }
+}
+
+/// Runs the command.
+pub fn run(a: &RenderArgs) -> Result<(), String> {
+    let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
+    let settings = |light: &_| frame_settings(a, light);
     let frames = a.frames as usize;
-    let Still { scene, tree, frame, load_s, render_s, frame_s } =
-        render_still(&a.scene, &a.kd.params_for(a.m.method)?, a.m.options(), settings, threads, frames)?;
-    let img = image::RgbaImage::from_raw(frame.width, frame.height, frame.rgba.as_flattened().to_vec())
-        .ok_or("frame buffer size mismatch")?;
-    img.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    let env = a.json.then(Environment::detect);
+    let options = a.m.options();
+    let still = render_still(&a.scene, &a.kd.params_for(a.m.method)?, options, settings, threads, frames)?;
+    still.image()?.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    let shown = std::fs::canonicalize(&a.out).unwrap_or_else(|_| a.out.clone());
+    let Still { scene, tree, camera, light, frame, load_s, render_s, frame_s } = &still;
+    let stats = &frame.stats;
+    let (min, max) = frame_s.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+    if let Some(env) = env {
+        let v = json!({
+            "environment": env,
+            "scene": a.scene.scene,
+            "triangles": scene.triangle_count(),
+            "camera": camera,
+            "light": light,
+            "settings": frame_settings(a, light),
+            "options": options,
+            "threads": threads,
+            "load_seconds": load_s,
+            "kd_build_seconds": tree.build_time().as_secs_f64(),
+            "kd_params": tree.params(),
+            "frames": frames,
+            "frame_seconds": { "median": render_s, "min": min, "max": max, "each": frame_s },
+            "fps": 1.0 / render_s,
+            "stages_seconds": frame.stages,
+            "counters": stats,
+            "mrays_per_second": stats.rays as f64 / render_s / 1e6,
+            "nodes_per_ray": stats.nodes_per_ray(),
+            "nodes_per_packet": stats.nodes_per_packet(),
+            "isects_per_packet": stats.isects_per_packet(),
+            "culled_percent": stats.culled_percent(),
+            "cache_hit_rate": stats.cache_hit_rate(),
+            "out": shown,
+        });
+        println!("{v}");
+        return Ok(());
+    }
     println!(
         "{}: {} triangles, loaded in {:.3} s, kd-tree (C_trav {}) in {:.3} s; rendered {}x{} with {} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",
         a.scene.scene,
@@ -88,8 +132,8 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         a.m.method,
         render_s,
         threads,
-        frame.stats.rays as f64 / render_s / 1e6,
-        frame.stats.nodes_per_ray(),
+        stats.rays as f64 / render_s / 1e6,
+        stats.nodes_per_ray(),
     );
     let stages: Vec<String> = raylab_core::render::StageTimes::NAMES
         .iter()
@@ -98,7 +142,6 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         .map(|(name, t)| format!("{name} {:.1} ms", t * 1e3))
         .collect();
     if frames > 1 {
-        let (min, max) = frame_s.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| (lo.min(t), hi.max(t)));
         println!(
             "{frames} frames: median {:.2} ms ({:.1} FPS), min {:.2} ms, max {:.2} ms",
             render_s * 1e3,
@@ -109,7 +152,13 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
     }
     let which = if frames > 1 { "median frame, summed over threads" } else { "summed over threads" };
     println!("stages ({which}): {}", stages.join(", "));
-    let shown = std::fs::canonicalize(&a.out).unwrap_or_else(|_| a.out.clone());
+    println!(
+        "counters: {} rays, N {:.2} nodes and I {:.2} triangle tests per packet, {:.1}% of packet/leaf visits culled",
+        stats.rays,
+        stats.nodes_per_packet(),
+        stats.isects_per_packet(),
+        stats.culled_percent()
+    );
     println!("wrote {}", shown.display());
     Ok(())
 }

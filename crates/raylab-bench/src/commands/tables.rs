@@ -139,12 +139,11 @@ pub fn measure_interleaved(
         .map(|(t, l)| {
             t.sort_by(f64::total_cmp);
             let (stats, stages) = l.unwrap_or_default();
-            let tested = stats.packets_culled + stats.packets_tested;
             Cell {
                 fps: t.get(t.len() / 2).map_or(0.0, |m| 1.0 / m),
                 n: stats.nodes_per_packet(),
                 i: stats.isects_per_packet(),
-                culled: if tested == 0 { 0.0 } else { 100.0 * stats.packets_culled as f64 / tested as f64 },
+                culled: stats.culled_percent(),
                 stages,
                 cache_hit_rate: stats.cache_hit_rate(),
             }

@@ -102,12 +102,6 @@ impl Default for Readouts {
     }
 }
 
-/// Culled share of packet visits to leaves, in percent.
-fn culled_pct(s: &TraversalStats) -> f64 {
-    let visits = s.packets_culled + s.packets_tested;
-    if visits == 0 { 0.0 } else { 100.0 * s.packets_culled as f64 / visits as f64 }
-}
-
 impl Readouts {
     /// Adds a traced frame.
     pub fn push(&mut self, r: &Rendered) {
@@ -259,7 +253,7 @@ impl Readouts {
             row("rays/frame", format!("{}", s.rays));
             row("N (nodes/packet)", format!("{:.2}", s.nodes_per_packet()));
             row("I (isects/packet)", format!("{:.2}", s.isects_per_packet()));
-            row("packets culled", format!("{:.1} %", culled_pct(&s)));
+            row("packets culled", format!("{:.1} %", s.culled_percent()));
             if s.cache_lookups > 0 {
                 row("shadow cache hits", format!("{:.1} %", 100.0 * s.cache_hit_rate()));
             }
@@ -305,7 +299,7 @@ impl Readouts {
             rays_per_frame: self.totals.rays as f64 / n,
             n: self.totals.nodes_per_packet(),
             i: self.totals.isects_per_packet(),
-            culled_pct: culled_pct(&self.totals),
+            culled_pct: self.totals.culled_percent(),
             stage_ms_per_frame: self.stages.as_array().map(|s| s * 1e3 / n),
             upload_ms_mean: mean_of(&self.upload, |c| c.cpu_ms),
             upload_wall_ms_mean: mean_of(&self.upload, |c| c.wall_ms),
