@@ -14,13 +14,15 @@ frames=${FRAMES:-10}
 cargo build --release -p raylab-bench --manifest-path "$root/Cargo.toml"
 
 cd "$root"
+mkdir -p target/bench
 table=$(mktemp)
 part=$(mktemp)
 for kind in primary diffuse; do
   for threads in 1 2; do
     target/release/raylab-bench animate --scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 \
       --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0 --width 512 --height 512 --kind "$kind" \
-      --threads "$threads" --frames "$frames" --markdown "$part"
+      --threads "$threads" --frames "$frames" --markdown "$part" \
+      --json "target/bench/animate-$kind-$threads.json"
     cat "$part" >> "$table"
     echo >> "$table"
   done

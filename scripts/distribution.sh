@@ -17,10 +17,11 @@ scene_size=${SCENE_SIZE:-128}
 cargo build --release -p raylab-bench --manifest-path "$root/Cargo.toml"
 
 cd "$root"
+mkdir -p target/bench
 table=$(mktemp)
 target/release/raylab-bench distribution --scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 \
   --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0 --width "$size" --height "$size" --bounces "$bounces" \
-  --threads 1 --groups 1,2,8,16 --markdown "$table"
+  --threads 1 --groups 1,2,8,16 --markdown "$table" --json target/bench/distribution.json
 for scene in atrium kitchen arena forest; do
   part=$(mktemp)
   target/release/raylab-bench distribution --scene "$scene" --methods mbvh,mbvh-rs --width "$scene_size" \

@@ -12,9 +12,11 @@ reps=${REPS:-5}
 cargo build --release -p raylab-bench --manifest-path "$root/Cargo.toml"
 
 cd "$root"
+mkdir -p target/bench
 table=$(mktemp)
 target/release/raylab-bench tables --part primary --scene ../shared/scenes/sponza/sponza.obj --eye -12.5,2.5,0 \
-  --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0 --threads 2 --reps "$reps" --markdown "$table"
+  --target 10,5.5,0 --up 0,1,0 --fov 65 --light 0,11,0 --threads 2 --reps "$reps" --markdown "$table" \
+  --json target/bench/thesis-tables.json
 
 splice_section thesis-tables "$table"
 python3 scripts/targets.py

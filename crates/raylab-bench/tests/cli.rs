@@ -177,6 +177,8 @@ fn tables_print_the_thesis_tables() {
             "tables",
             "--builtins",
             "arena",
+            "--shading-builtins",
+            "arena",
             "--scene",
             "arena",
             "--width",
@@ -193,6 +195,8 @@ fn tables_print_the_thesis_tables() {
             "img",
             "--markdown",
             out.to_str().unwrap(),
+            "--json",
+            "tables.json",
         ],
         dir.path(),
     );
@@ -215,6 +219,26 @@ fn tables_print_the_thesis_tables() {
     for technique in ["hard", "edge", "ms4", "ms32", "ms1024"] {
         assert!(dir.path().join(format!("img/arena-{technique}.png")).is_file(), "no {technique} image");
     }
+
+    // The same tables as flat JSON records, one per measured cell.
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.path().join("tables.json")).unwrap()).unwrap();
+    let records = v["records"].as_array().unwrap_or_else(|| panic!("{v}"));
+    let of = |table: &str| records.iter().filter(|r| r["table"] == table).collect::<Vec<_>>();
+    let counts = ["4.1", "4.2", "4.3", "4.5", "5.1", "4.6", "3.1", "quality"].map(|t| of(t).len());
+    assert_eq!(counts, [5, 1, 4, 6, 6, 8, 1, 6], "{v}");
+    assert!(records.iter().all(|r| r["scene"] == "arena"), "{v}");
+    let packet = of("4.1")[0];
+    assert_eq!((&packet["method"], packet["cull"].as_bool()), (&"packet".into(), Some(true)));
+    assert_eq!((&of("4.2")[0]["method"], of("4.2")[0]["cull"].as_bool()), (&"frustum".into(), Some(false)));
+    // The markdown's Table 4.1 row starts with the packets' FPS, N and I, as the record holds them.
+    let row = md.lines().find(|l| l.starts_with("| arena | ")).unwrap();
+    let cell = |k: &str, digits: usize| format!("{:.*}", digits, packet[k].as_f64().unwrap());
+    assert!(row.starts_with(&format!("| arena | {} | {} | {} |", cell("fps", 1), cell("n", 2), cell("i", 2))), "{row}");
+    let radii: Vec<f64> = of("4.6").iter().map(|r| r["light_radius"].as_f64().unwrap()).collect();
+    assert_eq!(radii, [1.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 2.0]);
+    assert_eq!(of("4.6")[0]["shadows"]["bound"], "cone");
+    assert_eq!(of("3.1")[0]["split_seconds"].as_object().map(|m| m.len()), Some(7), "{v}");
+    assert!(of("quality").iter().all(|r| r["rmse"].as_f64().is_some_and(|e| e >= 0.0)), "{v}");
 }
 
 #[test]
@@ -346,6 +370,8 @@ fn distribution_prints_per_bounce_speeds_for_each_method() {
             "2,4",
             "--out",
             "d.png",
+            "--json",
+            "d.json",
         ],
         dir.path(),
     );
@@ -363,6 +389,19 @@ fn distribution_prints_per_bounce_speeds_for_each_method() {
     let groups: Vec<&str> = sweep.lines().filter_map(|l| l.strip_prefix("| ")?.split(' ').next()).collect();
     assert_eq!(groups[1..], ["16", "64"], "{sweep}");
     assert!(dir.path().join("d.png").is_file());
+    // The JSON holds every run: the four methods, then the sweep's MBVH RS groups, each with its three bounces.
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.path().join("d.json")).unwrap()).unwrap();
+    let runs = v["runs"].as_array().unwrap_or_else(|| panic!("{v}"));
+    let names: Vec<_> = runs.iter().map(|r| (r["method"].as_str().unwrap(), r["group"].as_u64())).collect();
+    assert_eq!(names[3..], [("mbvh-rs", Some(64)), ("mbvh-rs", Some(16)), ("mbvh-rs", Some(64))], "{v}");
+    assert_eq!(names[..3], [("mono", None), ("packet", None), ("mbvh", None)]);
+    for r in runs {
+        let bounces = r["bounces"].as_array().unwrap();
+        assert_eq!(bounces.len(), 3, "{r}");
+        // Every camera ray of the 16x16 image's 4 paths per pixel.
+        assert_eq!(bounces[0]["work"]["rays"].as_u64(), Some(16 * 16 * 4), "{r}");
+        assert!(bounces[0]["mrays_per_second"].as_f64().unwrap() > 0.0, "{r}");
+    }
     let o = bench(&["distribution", "--scene", "arena", "--bounces", "9"], dir.path());
     assert!(!o.status.success() && stderr(&o).contains("1..=7"));
 }
@@ -414,6 +453,8 @@ fn dacrt_traces_and_animate_reports_every_update_strategy() {
             "2",
             "--markdown",
             md.to_str().unwrap(),
+            "--json",
+            "animate.json",
         ],
         dir.path(),
     );
@@ -421,6 +462,17 @@ fn dacrt_traces_and_animate_reports_every_update_strategy() {
     let table = std::fs::read_to_string(&md).unwrap();
     for row in ["| mono | kd-tree rebuilt |", "| mbvh | MBVH refitted |", "| dacrt | triangles copied, top divided |"] {
         assert!(table.contains(row), "{row} missing from:\n{table}");
+    }
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("animate.json")).unwrap()).unwrap();
+    let methods = v["methods"].as_array().unwrap_or_else(|| panic!("{v}"));
+    assert_eq!(methods.iter().map(|m| m["method"].as_str().unwrap()).collect::<Vec<_>>(), ["mono", "mbvh", "dacrt"]);
+    assert!(v["moving_triangles"].as_u64().unwrap() > 0 && v["rays_per_frame"].as_u64() == Some(1200), "{v}");
+    for m in methods {
+        let frames = m["frames"]["total_ms"].as_array().unwrap();
+        assert_eq!(frames.len(), 2, "every frame's time: {m}");
+        let most = frames.iter().map(|t| t.as_f64().unwrap()).fold(0.0, f64::max);
+        assert!(m["median_total_ms"].as_f64().unwrap() <= most && most > 0.0, "{m}");
     }
     let o = bench(&["animate", "--frames", "0"], dir.path());
     assert!(!o.status.success() && stderr(&o).contains("--frames"), "{}", stderr(&o));

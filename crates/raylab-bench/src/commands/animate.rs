@@ -17,6 +17,7 @@ use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 use raylab_scene::animation::Animation;
 use serde::Serialize;
+use serde_json::json;
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_non_negative};
 use crate::env::Environment;
@@ -54,9 +55,13 @@ pub struct AnimateArgs {
     /// Also write the markdown table to this file.
     #[arg(long)]
     markdown: Option<PathBuf>,
+    /// Also write the run as one JSON object to this file: every frame's update and trace times per method
+    /// beside the medians of the table.
+    #[arg(long)]
+    json: Option<PathBuf>,
 }
 
-/// One method's times per frame.
+/// One method's times per frame, in milliseconds.
 #[derive(Clone, Debug, Default, Serialize)]
 struct Row {
     update_ms: Vec<f64>,
@@ -151,6 +156,34 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
     print!("{md}");
     if let Some(p) = &a.markdown {
         std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
+    }
+    if let Some(p) = &a.json {
+        let v = json!({
+            "environment": env,
+            "command": cmd,
+            "scene": a.scene.scene,
+            "triangles": scene.triangle_count(),
+            "moving_triangles": anim.moving_triangles(),
+            "kind": a.kind,
+            "rays_per_frame": rays,
+            "frames": a.frames,
+            "step_seconds": a.step,
+            "threads": a.threads,
+            "kd_params": params,
+            "methods": methods.iter().zip(&rows).map(|((method, what), row)| {
+                let total = median(&row.total_ms);
+                json!({
+                    "method": method,
+                    "structure_update": what,
+                    "median_update_ms": median(&row.update_ms),
+                    "median_trace_ms": median(&row.trace_ms),
+                    "median_total_ms": total,
+                    "mrays_per_second_with_update": rays as f64 / (total * 1e3).max(1e-9),
+                    "frames": row,
+                })
+            }).collect::<Vec<_>>(),
+        });
+        std::fs::write(p, format!("{v:#}\n")).map_err(|e| format!("--json: cannot write {}: {e}", p.display()))?;
     }
     Ok(())
 }

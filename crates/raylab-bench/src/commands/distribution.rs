@@ -11,6 +11,7 @@ use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::stats::TraversalStats;
 use raylab_core::trace::{TraceOptions, Tracer};
+use serde_json::json;
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_non_negative};
 use crate::env::Environment;
@@ -62,6 +63,10 @@ pub struct DistributionArgs {
     /// Also write the markdown tables to this file.
     #[arg(long)]
     markdown: Option<PathBuf>,
+    /// Also write the run as one JSON object to this file: per method (and MBVH RS group), each bounce's
+    /// rays, thread-summed seconds and counters for closest-hit and shadow rays, and the speeds.
+    #[arg(long)]
+    json: Option<PathBuf>,
     /// Write only the speed table (Figure 2), titled with the scene, for comparing scenes.
     #[arg(long)]
     speeds_only: bool,
@@ -132,6 +137,33 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
     if let Some(p) = &a.markdown {
         std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
     }
+    if let Some(p) = &a.json {
+        let v = json!({
+            "environment": env,
+            "command": cmd,
+            "scene": scene_name,
+            "camera": camera,
+            "light": light,
+            "width": a.width,
+            "height": a.height,
+            "paths_per_pixel": a.spp,
+            "bounces": a.bounces,
+            "glossy_exponent": a.glossy_exponent,
+            "all_glossy": !a.materials,
+            "threads": a.threads,
+            "runs": runs.iter().map(|r| json!({
+                "method": r.method,
+                "group": r.group,
+                "group_sweep": r.sweep,
+                "bounces": r.bounces.iter().map(|b| json!({
+                    "mrays_per_second": mrays(b.rays, b.seconds),
+                    "shadow_mrays_per_second": mrays(b.shadow_rays, b.shadow_seconds),
+                    "work": b,
+                })).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+        });
+        std::fs::write(p, format!("{v:#}\n")).map_err(|e| format!("--json: cannot write {}: {e}", p.display()))?;
+    }
     if let (Some(out), Some(acc)) = (&a.out, first_image) {
         image::RgbaImage::from_raw(acc.width, acc.height, acc.rgba().as_flattened().to_vec())
             .ok_or("frame buffer size mismatch")?
@@ -139,6 +171,11 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
             .map_err(|e| format!("--out: cannot write {}: {e}", out.display()))?;
     }
     Ok(())
+}
+
+/// Millions of rays per thread-second (0 where nothing was timed).
+fn mrays(rays: u64, seconds: f64) -> f64 {
+    rays as f64 / seconds.max(1e-12) / 1e6
 }
 
 /// One method's pass: its MBVH RS group size (`None` for other methods) and the work per bounce.
@@ -171,7 +208,7 @@ fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: Opti
             let _ = write!(md, " bounce {b} |");
         }
     };
-    let rate = |rays: u64, s: f64| rays as f64 / s.max(1e-12) / 1e6;
+    let rate = mrays;
 
     let title = match speeds_only {
         Some(scene) => format!("**Figure 2**, {scene}"),

@@ -13,7 +13,9 @@ use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::shadow::{SampleBound, Shadows};
 use raylab_core::trace::{TraceOptions, Tracer};
 
-use super::tables::{Cell, measure, measure_interleaved};
+use serde_json::{Value, json};
+
+use super::tables::{Cell, measure, measure_interleaved, record};
 
 /// What the shading tables need besides the scenes.
 pub struct ShadingRun<'a> {
@@ -61,7 +63,7 @@ impl ShadingRun<'_> {
     }
 
     /// Writes Tables 5.1, 4.6 and 3.1 and the image-quality table for `subjects` into `md`.
-    pub fn write(&self, subjects: &[Subject], md: &mut String) -> Result<(), String> {
+    pub fn write(&self, subjects: &[Subject], md: &mut String, records: &mut Vec<Value>) -> Result<(), String> {
         let (w, h) = self.size;
         let _ = writeln!(
             md,
@@ -71,17 +73,25 @@ impl ShadingRun<'_> {
             self.reps,
             t = self.tile
         );
-        self.table_5_1(subjects, md);
-        self.table_4_6(subjects, md);
-        self.table_3_1(subjects, md);
-        self.quality(subjects, md)
+        self.table_5_1(subjects, md, records);
+        self.table_4_6(subjects, md, records);
+        self.table_3_1(subjects, md, records);
+        self.quality(subjects, md, records)
+    }
+
+    /// A JSON record of a shading-table cell: what was measured (table, scene, shadow technique, light radius,
+    /// reflection depth, MFT at the run's tile) and the cell.
+    fn record(&self, table: &str, s: &Subject, shadows: &Shadows, light_radius: f32, depth: u32, c: &Cell) -> Value {
+        let head = json!({ "table": table, "scene": s.name, "method": Method::Mft, "tile": self.tile, "cull": true,
+            "shadows": shadows, "light_radius": light_radius, "depth": depth });
+        record(head, c)
     }
 
     fn tracer<'t>(s: &'t Subject) -> Tracer<'t> {
         Tracer::new(s.tree, None, TraceOptions { method: Method::Mft, ..TraceOptions::default() })
     }
 
-    fn table_5_1(&self, subjects: &[Subject], md: &mut String) {
+    fn table_5_1(&self, subjects: &[Subject], md: &mut String, records: &mut Vec<Value>) {
         let _ = writeln!(
             md,
             "\n**Table 5.1**: shadow techniques, primary rays only (no reflections), FPS (and frame time against \
@@ -98,19 +108,16 @@ impl ShadingRun<'_> {
             let tracer = Self::tracer(s);
             let light = s.light.soft();
             let r = light.radius;
-            let cells = self.timed_together(
-                s,
-                &tracer,
-                light,
-                &[
-                    Shadows::None,
-                    Shadows::Hard,
-                    Shadows::Cached,
-                    Shadows::EdgeWidth { radius: r, leak_fix: false },
-                    Shadows::MultiSample { samples: 4, bound: SampleBound::default() },
-                    Shadows::MultiSample { samples: 32, bound: SampleBound::default() },
-                ],
-            );
+            let techniques = [
+                Shadows::None,
+                Shadows::Hard,
+                Shadows::Cached,
+                Shadows::EdgeWidth { radius: r, leak_fix: false },
+                Shadows::MultiSample { samples: 4, bound: SampleBound::default() },
+                Shadows::MultiSample { samples: 32, bound: SampleBound::default() },
+            ];
+            let cells = self.timed_together(s, &tracer, light, &techniques);
+            records.extend(techniques.iter().zip(&cells).map(|(t, c)| self.record("5.1", s, t, r, 0, c)));
             let [none, hard, cached, edge, ms4, ms32] = cells[..] else { unreachable!("six techniques") };
             let _ = writeln!(
                 md,
@@ -128,7 +135,7 @@ impl ShadingRun<'_> {
         }
     }
 
-    fn table_4_6(&self, subjects: &[Subject], md: &mut String) {
+    fn table_4_6(&self, subjects: &[Subject], md: &mut String, records: &mut Vec<Value>) {
         let _ = writeln!(
             md,
             "\n**Table 4.6**: 16 samples per point, bounded by the cone or the square pyramid around the light \
@@ -145,6 +152,7 @@ impl ShadingRun<'_> {
                 let techniques = bounds.map(|bound| Shadows::MultiSample { samples: 16, bound });
                 let cells: Vec<(SampleBound, Cell)> =
                     bounds.into_iter().zip(self.timed_together(s, &tracer, light, &techniques)).collect();
+                records.extend(techniques.iter().zip(&cells).map(|(t, (_, c))| self.record("4.6", s, t, radius, 0, c)));
                 let cone = cells[0].1.fps;
                 for (bound, c) in &cells {
                     let speedup =
@@ -163,7 +171,7 @@ impl ShadingRun<'_> {
         }
     }
 
-    fn table_3_1(&self, subjects: &[Subject], md: &mut String) {
+    fn table_3_1(&self, subjects: &[Subject], md: &mut String, records: &mut Vec<Value>) {
         let _ = writeln!(
             md,
             "\n**Table 3.1**: share of the frame per stage, hard shadows, reflections and refractions to depth {} \
@@ -186,6 +194,12 @@ impl ShadingRun<'_> {
             let per_test = crate::isect_cost::seconds_per_packet_test(s.tree, &s.camera, w, h, backend).unwrap_or(0.0);
             let split = c.stages.split(per_test);
             let total: f64 = split.iter().sum();
+            let mut v = self.record("3.1", s, &Shadows::Hard, s.light.radius, RenderSettings::DEFAULT_DEPTH, &c);
+            v["seconds_per_test"] = json!(per_test);
+            v["split_seconds"] = json!(
+                names.iter().zip(split).map(|(n, t)| (n.to_string(), json!(t))).collect::<serde_json::Map<_, _>>()
+            );
+            records.push(v);
             let _ = write!(md, "| {} | {:.1} | {:.1} |", s.name, c.fps, per_test * 1e9);
             for t in split {
                 let _ = write!(md, " {:.1}% |", if total > 0.0 { 100.0 * t / total } else { 0.0 });
@@ -194,7 +208,7 @@ impl ShadingRun<'_> {
         }
     }
 
-    fn quality(&self, subjects: &[Subject], md: &mut String) -> Result<(), String> {
+    fn quality(&self, subjects: &[Subject], md: &mut String, records: &mut Vec<Value>) -> Result<(), String> {
         let (w, h) = self.quality_size;
         let _ = writeln!(
             md,
@@ -223,7 +237,10 @@ impl ShadingRun<'_> {
             let _ = write!(md, "| {} |", s.name);
             for (label, shadows) in techniques {
                 let f = shot(shadows);
-                let _ = write!(md, " {:.2} |", rmse(&f, &reference));
+                let error = rmse(&f, &reference);
+                let _ = write!(md, " {error:.2} |");
+                records.push(json!({ "table": "quality", "scene": s.name, "technique": label, "shadows": shadows,
+                    "light_radius": r, "width": w, "height": h, "reference_samples": 1024, "rmse": error }));
                 if let Some(dir) = self.images {
                     save(&f, &dir.join(format!("{}-{label}.png", s.name)))?;
                 }

@@ -14,6 +14,8 @@ use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::shadow::Shadows;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_simd::Backend;
+use serde::Serialize;
+use serde_json::{Value, json};
 
 use super::shading_tables::{ShadingRun, Subject};
 use crate::args::{KdArgs, SceneArgs, in_range};
@@ -47,6 +49,11 @@ pub struct TablesArgs {
     /// Also write the markdown to this file.
     #[arg(long)]
     markdown: Option<PathBuf>,
+    /// Also write the tables as one JSON object to this file: the machine and the run's settings, and one
+    /// flat record per measured cell (its table, scene, method, tile and shadow technique beside FPS, N, I,
+    /// culled packets and stage times), ready for a data frame.
+    #[arg(long)]
+    json: Option<PathBuf>,
     /// Which tables: primary (4.1-4.5), shading (5.1, 4.6, 3.1 and image quality) or all.
     #[arg(long, value_enum, default_value_t = Part::All)]
     part: Part,
@@ -77,7 +84,7 @@ pub enum Part {
 }
 
 /// One measured configuration.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Serialize)]
 pub struct Cell {
     /// Frames per second from the median frame time.
     pub fps: f64,
@@ -149,6 +156,15 @@ pub fn measure_interleaved(
             }
         })
         .collect()
+}
+
+/// A JSON record of `cell`: the fields of `head` (what was measured) followed by the cell's.
+pub fn record(head: Value, cell: &Cell) -> Value {
+    let mut v = head;
+    if let (Some(o), Ok(Value::Object(c))) = (v.as_object_mut(), serde_json::to_value(cell)) {
+        o.extend(c);
+    }
+    v
 }
 
 fn pct(a: f64, b: f64) -> String {
@@ -234,6 +250,19 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
             cone: cells[2 + 2 * n..5 + 2 * n].to_vec(),
             mft_cone: cells[5 + 2 * n..8 + 2 * n].to_vec(),
         });
+    }
+
+    let mut records = Vec::new();
+    for r in &rows {
+        let cell = |table: &str, method: Method, tile: u32, cull: bool, c: &Cell| {
+            record(json!({ "table": table, "scene": r.name, "method": method, "tile": tile, "cull": cull }), c)
+        };
+        records.push(cell("4.1", Method::Packet, 16, true, &r.packet));
+        records.extend(r.frustum.iter().zip(tiles).map(|(c, t)| cell("4.1", Method::Frustum, t, true, c)));
+        records.push(cell("4.2", Method::Frustum, 8, false, &r.nocull8));
+        records.extend(r.mft.iter().zip(tiles).map(|(c, t)| cell("4.3", Method::Mft, t, true, c)));
+        records.extend(r.cone.iter().zip(tiles).map(|(c, t)| cell("4.5", Method::Cone, t, true, c)));
+        records.extend(r.mft_cone.iter().zip(tiles).map(|(c, t)| cell("4.5", Method::MftCone, t, true, c)));
     }
 
     let mut md = String::new();
@@ -372,11 +401,25 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
                 light: *light,
             })
             .collect();
-        run.write(&subjects, &mut md)?;
+        run.write(&subjects, &mut md, &mut records)?;
     }
     print!("{md}");
     if let Some(p) = &a.markdown {
         std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
+    }
+    if let Some(p) = &a.json {
+        let v = json!({
+            "environment": env,
+            "command": cmd,
+            "width": a.width,
+            "height": a.height,
+            "threads": a.threads,
+            "reps": a.reps,
+            "backend": backend.name(),
+            "kd_params": params,
+            "records": records,
+        });
+        std::fs::write(p, format!("{v:#}\n")).map_err(|e| format!("--json: cannot write {}: {e}", p.display()))?;
     }
     Ok(())
 }
