@@ -1,5 +1,6 @@
 //! `raylab-bench render`: one frame, shaded with the scene's materials under a chosen shadow technique,
-//! written as PNG.
+//! written as PNG; with `--frames` the same frame rendered again and again to time it as a viewer would, and
+//! with `--json` the times, stages and counters as one JSON object.
 
 use std::path::PathBuf;
 
