@@ -153,6 +153,8 @@ pub struct Automation {
 /// The `--json-stats` file.
 #[derive(Serialize)]
 struct StatsFile<'a> {
+    /// The machine and build, as `raylab-bench`'s JSON reports give them.
+    environment: raylab_bench::env::Environment,
     scene: &'a str,
     triangles: usize,
     gpu: &'a str,
@@ -205,6 +207,7 @@ impl Automation {
         if let Some(p) = &self.json_stats {
             let latest = lab.latest().ok_or("no frame was traced")?;
             let file = StatsFile {
+                environment: raylab_bench::env::Environment::detect(),
                 scene: &lab.scene().name,
                 triangles: lab.scene().scene.triangle_count(),
                 gpu: &lab.gpu_name,

@@ -103,6 +103,7 @@ fn rect(v: &serde_json::Value) -> [f32; 4] {
 fn check(name: &str, shot: &image::RgbaImage, stats: &serde_json::Value, want: &image::RgbaImage) {
     assert_eq!(shot.dimensions(), (W, H), "{name}: window size");
     assert_eq!(stats["render"], serde_json::json!([W, H]), "{name}: render resolution");
+    assert!(stats["environment"]["cpus"].as_u64().is_some_and(|n| n > 0), "{name}: the machine is named");
     let covered: Vec<[f32; 4]> = stats["ui_rects"].as_array().unwrap().iter().map(rect).collect();
     let inside = |x: u32, y: u32, r: &[f32; 4], m: f32| {
         let (x, y) = (x as f32 + 0.5, y as f32 + 0.5);
