@@ -230,6 +230,8 @@ fn tables_print_the_thesis_tables() {
     let packet = of("4.1")[0];
     assert_eq!((&packet["method"], packet["cull"].as_bool()), (&"packet".into(), Some(true)));
     assert_eq!((&of("4.2")[0]["method"], of("4.2")[0]["cull"].as_bool()), (&"frustum".into(), Some(false)));
+    // Named as in the render and trace reports.
+    assert!(of("4.1")[1]["culled_percent"].as_f64().is_some_and(|c| c > 0.0), "{v}");
     // The markdown's Table 4.1 row starts with the packets' FPS, N and I, as the record holds them.
     let row = md.lines().find(|l| l.starts_with("| arena | ")).unwrap();
     let cell = |k: &str, digits: usize| format!("{:.*}", digits, packet[k].as_f64().unwrap());

@@ -208,7 +208,6 @@ fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: Opti
             let _ = write!(md, " bounce {b} |");
         }
     };
-    let rate = mrays;
 
     let title = match speeds_only {
         Some(scene) => format!("**Figure 2**, {scene}"),
@@ -221,7 +220,7 @@ fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: Opti
     for r in runs {
         let _ = write!(md, "| {} |", r.label());
         for b in &r.bounces {
-            let _ = write!(md, " {:.2} |", rate(b.rays, b.seconds));
+            let _ = write!(md, " {:.2} |", mrays(b.rays, b.seconds));
         }
         let sum = |f: fn(&BounceStats) -> f64| r.bounces.iter().map(f).sum::<f64>();
         let (shadow_rays, shadow_s) = (sum(|b| b.shadow_rays as f64), sum(|b| b.shadow_seconds));
@@ -229,8 +228,8 @@ fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: Opti
         let _ = writeln!(
             md,
             " {:.2} | {:.2} |",
-            rate(shadow_rays as u64, shadow_s),
-            rate((rays + shadow_rays) as u64, secs + shadow_s)
+            mrays(shadow_rays as u64, shadow_s),
+            mrays((rays + shadow_rays) as u64, secs + shadow_s)
         );
     }
 

@@ -17,6 +17,9 @@ use serde_json::{Value, json};
 
 use super::tables::{Cell, measure, measure_interleaved, record};
 
+/// Samples per point of the image-quality table's reference.
+const REFERENCE_SAMPLES: u32 = 1024;
+
 /// What the shading tables need besides the scenes.
 pub struct ShadingRun<'a> {
     /// Frame width and height for the timed tables.
@@ -212,7 +215,7 @@ impl ShadingRun<'_> {
         let (w, h) = self.quality_size;
         let _ = writeln!(
             md,
-            "\n**Image quality**: RMSE (8-bit display values, all channels) against 1024 stratified samples per \
+            "\n**Image quality**: RMSE (8-bit display values, all channels) against {REFERENCE_SAMPLES} stratified samples per \
              point, {w}x{h}, primary rays only.\n"
         );
         let _ =
@@ -225,7 +228,7 @@ impl ShadingRun<'_> {
             let shot = |shadows: Shadows| -> Frame {
                 self.pool.install(|| render(s.scene, &tracer, &s.camera, light, &self.settings(shadows, 0, (w, h))))
             };
-            let reference = shot(Shadows::MultiSample { samples: 1024, bound: SampleBound::default() });
+            let reference = shot(Shadows::MultiSample { samples: REFERENCE_SAMPLES, bound: SampleBound::default() });
             let techniques = [
                 ("hard", Shadows::Hard),
                 ("edge", Shadows::EdgeWidth { radius: r, leak_fix: false }),
@@ -240,14 +243,14 @@ impl ShadingRun<'_> {
                 let error = rmse(&f, &reference);
                 let _ = write!(md, " {error:.2} |");
                 records.push(json!({ "table": "quality", "scene": s.name, "technique": label, "shadows": shadows,
-                    "light_radius": r, "width": w, "height": h, "reference_samples": 1024, "rmse": error }));
+                    "light_radius": r, "width": w, "height": h, "reference_samples": REFERENCE_SAMPLES, "rmse": error }));
                 if let Some(dir) = self.images {
                     save(&f, &dir.join(format!("{}-{label}.png", s.name)))?;
                 }
             }
             let _ = writeln!(md);
             if let Some(dir) = self.images {
-                save(&reference, &dir.join(format!("{}-ms1024.png", s.name)))?;
+                save(&reference, &dir.join(format!("{}-ms{REFERENCE_SAMPLES}.png", s.name)))?;
             }
         }
         if let Some(dir) = self.images {

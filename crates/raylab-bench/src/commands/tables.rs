@@ -92,7 +92,8 @@ pub struct Cell {
     pub n: f64,
     /// The thesis's I, triangle tests per packet.
     pub i: f64,
-    /// Culled packet visits in percent.
+    /// Culled packet visits in percent (`culled_percent` in JSON, as in the other commands' reports).
+    #[serde(rename = "culled_percent")]
     pub culled: f64,
     /// Stage times of the last frame.
     pub stages: StageTimes,
