@@ -4,6 +4,7 @@
 
 mod commands;
 mod isect_cost;
+mod output;
 mod timing;
 
 use raylab_bench::{args, env, prepare};

@@ -6,6 +6,23 @@ fn bench(args: &[&str], dir: &std::path::Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_raylab-bench")).args(args).current_dir(dir).output().expect("runs")
 }
 
+/// Runs `compare` on a 16x16 view of the arena, one thread, one run and one build, against the shell
+/// script `harness` standing in for the Embree harness, with `extra` flags.
+#[cfg(unix)]
+fn compare_with_fake_harness(dir: &std::path::Path, harness: &str, extra: &[&str]) -> Output {
+    use std::os::unix::fs::PermissionsExt;
+    let path = dir.join("embree_bench");
+    std::fs::write(&path, harness).unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let common = "--scene arena --width 16 --height 16 --threads 1 --reps 1 --builds 1";
+    let args: Vec<&str> = ["compare", "--embree", path.to_str().unwrap()]
+        .into_iter()
+        .chain(common.split(' '))
+        .chain(extra.iter().copied())
+        .collect();
+    bench(&args, dir)
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -506,41 +523,10 @@ esac
 #[cfg(unix)]
 #[test]
 fn compare_takes_turns_with_the_harness_and_reports_its_figures() {
-    use std::os::unix::fs::PermissionsExt;
     let dir = tempfile::tempdir().unwrap();
-    let harness = dir.path().join("embree_bench");
-    std::fs::write(&harness, FAKE_HARNESS).unwrap();
-    std::fs::set_permissions(&harness, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let o = bench(
-        &[
-            "compare",
-            "--embree",
-            harness.to_str().unwrap(),
-            "--scene",
-            "arena",
-            "--width",
-            "16",
-            "--height",
-            "16",
-            "--threads",
-            "1",
-            "--reps",
-            "1",
-            "--builds",
-            "1",
-            "--methods",
-            "mft",
-            "--tiles",
-            "4",
-            "--incoherent",
-            "mbvh-rs",
-            "--rs-groups",
-            "16",
-            "--json",
-            "compare.json",
-        ],
-        dir.path(),
-    );
+    let extra =
+        ["--methods", "mft", "--tiles", "4", "--incoherent", "mbvh-rs", "--rs-groups", "16", "--json", "compare.json"];
+    let o = compare_with_fake_harness(dir.path(), FAKE_HARNESS, &extra);
     assert!(o.status.success(), "{}", stderr(&o));
     // Builds first, then one turn per ray kind, in the order raylab measures them.
     let log = std::fs::read_to_string(dir.path().join("embree_bench.log")).unwrap();
@@ -612,37 +598,9 @@ esac
 #[cfg(unix)]
 #[test]
 fn compare_rounds_repeat_the_turns_and_report_the_median_round() {
-    use std::os::unix::fs::PermissionsExt;
     let dir = tempfile::tempdir().unwrap();
-    let harness = dir.path().join("embree_bench");
-    std::fs::write(&harness, FAKE_DRIFTING_HARNESS).unwrap();
-    std::fs::set_permissions(&harness, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let args = [
-        "compare",
-        "--embree",
-        harness.to_str().unwrap(),
-        "--scene",
-        "arena",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--threads",
-        "1",
-        "--reps",
-        "1",
-        "--builds",
-        "1",
-        "--methods",
-        "frustum",
-        "--tiles",
-        "8",
-        "--incoherent",
-        "mbvh",
-        "--rounds",
-        "3",
-    ];
-    let o = bench(&args, dir.path());
+    let extra = ["--methods", "frustum", "--tiles", "8", "--incoherent", "mbvh", "--rounds", "3"];
+    let o = compare_with_fake_harness(dir.path(), FAKE_DRIFTING_HARNESS, &extra);
     assert!(o.status.success(), "{}", stderr(&o));
     let log = std::fs::read_to_string(dir.path().join("embree_bench.log")).unwrap();
     assert_eq!(log, format!("none\n{}", "primary\nshadow\ndiffuse\n".repeat(3)));

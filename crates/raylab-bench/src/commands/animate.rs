@@ -21,6 +21,7 @@ use serde_json::json;
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_non_negative};
 use crate::env::Environment;
+use crate::output::{print_markdown, write_json};
 use crate::prepare::load_scene;
 use crate::timing::{DACRT_SET_TILE, HARNESS_TILE, summarize, trace_once, validate};
 
@@ -153,10 +154,7 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
             rays as f64 / (total * 1e3).max(1e-9)
         );
     }
-    print!("{md}");
-    if let Some(p) = &a.markdown {
-        std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
-    }
+    print_markdown(&md, a.markdown.as_deref())?;
     if let Some(p) = &a.json {
         let v = json!({
             "environment": env,
@@ -183,7 +181,7 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
                 })
             }).collect::<Vec<_>>(),
         });
-        std::fs::write(p, format!("{v:#}\n")).map_err(|e| format!("--json: cannot write {}: {e}", p.display()))?;
+        write_json(p, &v)?;
     }
     Ok(())
 }

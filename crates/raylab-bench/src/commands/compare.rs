@@ -23,6 +23,7 @@ use serde_json::json;
 
 use crate::args::{ImageArgs, KdArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
+use crate::output::{print_markdown, write_json};
 use crate::prepare::{build_tree, load_scene, with_spinner};
 use crate::timing::{DACRT_SET_TILE as DACRT_TILE, HARNESS_TILE, TraceReport, measure, tile_for_group, validate};
 
@@ -448,10 +449,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             );
         }
     }
-    print!("{md}");
-    if let Some(p) = &a.markdown {
-        std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
-    }
+    print_markdown(&md, a.markdown.as_deref())?;
     if let Some(p) = &a.json {
         let v = json!({
             "environment": env,
@@ -487,7 +485,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                 .collect::<Vec<_>>(),
             "dacrt_setup_seconds": dacrt_setup,
         });
-        std::fs::write(p, format!("{v:#}\n")).map_err(|e| format!("--json: cannot write {}: {e}", p.display()))?;
+        write_json(p, &v)?;
     }
     Ok(())
 }

@@ -15,6 +15,7 @@ use serde_json::json;
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_non_negative};
 use crate::env::Environment;
+use crate::output::{print_markdown, write_json};
 use crate::prepare::{build_tree, load_scene, with_spinner};
 
 /// Traces the distribution workload with each method and prints per-bounce speeds and counters.
@@ -133,10 +134,7 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
         }
     }
     write_tables(&mut md, &runs, a.bounces as usize, a.speeds_only.then_some(scene_name.as_str()));
-    print!("{md}");
-    if let Some(p) = &a.markdown {
-        std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
-    }
+    print_markdown(&md, a.markdown.as_deref())?;
     if let Some(p) = &a.json {
         let v = json!({
             "environment": env,
@@ -162,7 +160,7 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
                 })).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
         });
-        std::fs::write(p, format!("{v:#}\n")).map_err(|e| format!("--json: cannot write {}: {e}", p.display()))?;
+        write_json(p, &v)?;
     }
     if let (Some(out), Some(acc)) = (&a.out, first_image) {
         image::RgbaImage::from_raw(acc.width, acc.height, acc.rgba().as_flattened().to_vec())

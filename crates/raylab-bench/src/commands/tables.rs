@@ -20,6 +20,7 @@ use serde_json::{Value, json};
 use super::shading_tables::{ShadingRun, Subject};
 use crate::args::{KdArgs, SceneArgs, in_range};
 use crate::env::Environment;
+use crate::output::{print_markdown, write_json};
 use crate::prepare::{build_tree, load_scene};
 
 /// Regenerates thesis Tables 4.1-4.5 for the built-in scenes and the scene given with `--scene` (for
@@ -404,10 +405,7 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
             .collect();
         run.write(&subjects, &mut md, &mut records)?;
     }
-    print!("{md}");
-    if let Some(p) = &a.markdown {
-        std::fs::write(p, &md).map_err(|e| format!("--markdown: cannot write {}: {e}", p.display()))?;
-    }
+    print_markdown(&md, a.markdown.as_deref())?;
     if let Some(p) = &a.json {
         let v = json!({
             "environment": env,
@@ -420,7 +418,7 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
             "kd_params": params,
             "records": records,
         });
-        std::fs::write(p, format!("{v:#}\n")).map_err(|e| format!("--json: cannot write {}: {e}", p.display()))?;
+        write_json(p, &v)?;
     }
     Ok(())
 }

@@ -19,33 +19,21 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{Disc, RayPacket, tile::Bundle};
+use super::{Disc, Frustum, RayPacket, tile::Bundle};
 
 /// A cone bounding a bundle of rays from one origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cone {
-    /// Apex: the common origin.
-    pub origin: Vec3,
     /// Unit axis.
     pub axis: Vec3,
     /// Tangent of the half-angle.
     pub tan_alpha: f32,
-    /// Per axis, for planes with `dist > 0`: the near factor `1 / (v_k + beta_k)` (Listing 4.4's
-    /// `precompute[0]`), +inf where no ray goes toward them.
-    pub pos_near: [f32; 3],
-    /// For `dist > 0`: the far factor `1 / (v_k - beta_k)` (`precompute[1]`), +inf where some ray runs
-    /// parallel to the axis or away from the plane.
-    pub pos_far: [f32; 3],
-    /// For `dist < 0`: the near factor `1 / (v_k - beta_k)`, -inf where no ray goes toward them.
-    pub neg_near: [f32; 3],
-    /// For `dist < 0`: the far factor `1 / (v_k + beta_k)`, -inf where some ray runs parallel or away.
-    pub neg_far: [f32; 3],
-    /// Smallest start depth.
-    pub t_min: f32,
-    /// Largest end distance (a bound on depth).
-    pub t_max: f32,
-    /// As [`super::Frustum::origin_slack`].
-    pub origin_slack: f32,
+    /// What the walks see of the cone: its apex, depth range and Listing 4.4's per-axis factors sorted by
+    /// sign, as a [`Frustum`]'s. For `dist > 0` the near factor is `1 / (v_k + beta_k)` (`precompute[0]`,
+    /// +inf where no ray goes toward the plane) and the far one `1 / (v_k - beta_k)` (`precompute[1]`, +inf
+    /// where some ray runs parallel to the axis or away); for `dist < 0` the same two swapped, -inf in
+    /// their place. Distances are depths along the axis.
+    pub bound: Frustum,
 }
 
 impl Cone {
@@ -92,10 +80,8 @@ impl Cone {
         let (hi, lo): ([f32; 3], [f32; 3]) =
             (std::array::from_fn(|k| v[k] + beta[k]), std::array::from_fn(|k| v[k] - beta[k]));
         let (inf, ninf) = (f32::INFINITY, f32::NEG_INFINITY);
-        Self {
+        let bound = Frustum {
             origin,
-            axis,
-            tan_alpha,
             pos_near: std::array::from_fn(|k| if hi[k] > 0.0 { 1.0 / hi[k] } else { inf }),
             pos_far: std::array::from_fn(|k| if lo[k] > 0.0 { 1.0 / lo[k] } else { inf }),
             neg_near: std::array::from_fn(|k| if lo[k] < 0.0 { 1.0 / lo[k] } else { ninf }),
@@ -103,7 +89,8 @@ impl Cone {
             t_min,
             t_max,
             origin_slack: 0.0,
-        }
+        };
+        Self { axis, tan_alpha, bound }
     }
 
     /// The cone of the valid rays of `packets`, which all start at `origin`.
@@ -124,27 +111,12 @@ impl Cone {
     }
 }
 
+/// Listing 4.3 with the omni-directional rule: the two edge depths, negative ones made infinite, in order;
+/// the per-sign factors of [`Cone::bound`] hold them already sorted.
 impl Bundle for Cone {
     #[inline(always)]
-    fn origin(&self) -> Vec3 {
-        self.origin
-    }
-
-    #[inline(always)]
-    fn t_range(&self) -> (f32, f32) {
-        (self.t_min, self.t_max)
-    }
-
-    #[inline(always)]
-    fn origin_slack(&self) -> f32 {
-        self.origin_slack
-    }
-
-    /// Listing 4.3 with the omni-directional rule: the two edge depths, negative ones made infinite, in
-    /// order; the per-sign factors hold them already sorted.
-    #[inline(always)]
-    fn factors(&self, k: usize) -> [f32; 4] {
-        [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]]
+    fn interval(&self) -> &Frustum {
+        &self.bound
     }
 }
 
@@ -199,7 +171,7 @@ mod tests {
                     let v = axis[k];
                     let beta = tan * (1.0 - v * v).max(0.0).sqrt();
                     for split in [-7.0f32, -2.5, -2.0, 0.0, 0.5, 1.0, 3.0] {
-                        let dist = split - c.origin[k];
+                        let dist = split - c.bound.origin[k];
                         let fix = |t: f32| if t < 0.0 || t.is_nan() { f32::INFINITY } else { t };
                         let (a, b) = (fix(dist * (1.0 / (v + beta))), fix(dist * (1.0 / (v - beta))));
                         let want = if dist == 0.0 { (0.0, f32::INFINITY) } else { (a.min(b), a.max(b)) };

@@ -219,17 +219,33 @@ pub fn overlaps_box<V: Vf32>(p: &RayPacket<V>, b: &Aabb, limit: V, slack: f32) -
 
 /// A bundle of rays from one origin, seen by the frustum walks only through the range of distances at which
 /// its rays cross an axis-aligned plane, which four factors per axis give by the side of the origin the plane
-/// lies on (`sign_crossing`): pyramid [`Frustum`]s and [`super::Cone`]s implement it.
+/// lies on (`sign_crossing`): pyramid [`Frustum`]s and [`super::Cone`]s implement it, each through its
+/// interval form.
 pub trait Bundle {
-    /// The common origin.
-    fn origin(&self) -> Vec3;
-    /// The range of distances the walk starts with.
-    fn t_range(&self) -> (f32, f32);
-    /// Distance by which the bundle's segments may miss its origin (see [`Frustum::origin_slack`]).
-    fn origin_slack(&self) -> f32;
-    /// Axis `k`'s factors `[pos_near, pos_far, neg_near, neg_far]` (see [`Frustum`]).
-    fn factors(&self, k: usize) -> [f32; 4];
+    /// The bundle's interval form: origin, distance range, origin slack and per-axis factors.
+    fn interval(&self) -> &Frustum;
 
+    /// The common origin.
+    #[inline(always)]
+    fn origin(&self) -> Vec3 {
+        self.interval().origin
+    }
+    /// The range of distances the walk starts with.
+    #[inline(always)]
+    fn t_range(&self) -> (f32, f32) {
+        (self.interval().t_min, self.interval().t_max)
+    }
+    /// Distance by which the bundle's segments may miss its origin (see [`Frustum::origin_slack`]).
+    #[inline(always)]
+    fn origin_slack(&self) -> f32 {
+        self.interval().origin_slack
+    }
+    /// Axis `k`'s factors `[pos_near, pos_far, neg_near, neg_far]` (see [`Frustum`]).
+    #[inline(always)]
+    fn factors(&self, k: usize) -> [f32; 4] {
+        let f = self.interval();
+        [f.pos_near[k], f.pos_far[k], f.neg_near[k], f.neg_far[k]]
+    }
     /// The range of distances at which the bundle crosses the plane `coordinate k = split`; infinite bounds
     /// mean "some ray never crosses in front of the origin".
     #[inline(always)]
@@ -240,20 +256,8 @@ pub trait Bundle {
 
 impl Bundle for Frustum {
     #[inline(always)]
-    fn origin(&self) -> Vec3 {
-        self.origin
-    }
-    #[inline(always)]
-    fn t_range(&self) -> (f32, f32) {
-        (self.t_min, self.t_max)
-    }
-    #[inline(always)]
-    fn origin_slack(&self) -> f32 {
-        self.origin_slack
-    }
-    #[inline(always)]
-    fn factors(&self, k: usize) -> [f32; 4] {
-        [self.pos_near[k], self.pos_far[k], self.neg_near[k], self.neg_far[k]]
+    fn interval(&self) -> &Frustum {
+        self
     }
 }
 

@@ -130,7 +130,7 @@ pub(super) fn cone_from<V: Vf32>(origin: Vec3, tile: &PacketTile<V>, set: Range<
 pub(super) fn toward_cone<V: Vf32>(b: &Bundled<V>, toward: Vec3, spread_limit: f32) -> Option<Cone> {
     let (segs, slack) = toward_segments(b.rays.clone(), toward, spread_limit)?;
     let mut c = Cone::bounding(toward, segs.iter().copied())?;
-    widen_toward(&mut c.t_max, &mut c.origin_slack, toward, slack);
+    widen_toward(&mut c.bound.t_max, &mut c.bound.origin_slack, toward, slack);
     Some(c)
 }
 

@@ -470,7 +470,7 @@ impl<'a> Tracer<'a> {
                 }
             }
             Method::Cone => match self.whole(tile, all.clone(), rays, toward, shared, cone_from, toward_cone) {
-                Some(c) => self.tree.occluded_frustum(&c, tile, all, cull, far_first(c.origin), blocked, stats),
+                Some(c) => self.tree.occluded_frustum(&c, tile, all, cull, far_first(c.bound.origin), blocked, stats),
                 None => rest[0] = all,
             },
             Method::Mft => match self.quadrants(tile, rays, toward, shared, frustum_from, toward_frustum) {

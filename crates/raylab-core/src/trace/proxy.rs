@@ -30,7 +30,7 @@ impl Proxy {
     pub fn apex(&self) -> Vec3 {
         match self {
             Proxy::Pyramid(f) => f.origin,
-            Proxy::Cone(c) => c.origin,
+            Proxy::Cone(c) => c.bound.origin,
         }
     }
 }

@@ -1,0 +1,46 @@
+//! Writing a command's report files: every command that takes `--markdown FILE` or `--json FILE` writes
+//! them the same way, and an error names the flag and the file.
+
+use std::path::Path;
+
+use serde_json::Value;
+
+/// Writes `text` to the file `path` given with `flag` (such as `--markdown`).
+pub fn write_text(flag: &str, path: &Path, text: &str) -> Result<(), String> {
+    std::fs::write(path, text).map_err(|e| format!("{flag}: cannot write {}: {e}", path.display()))
+}
+
+/// Prints the markdown report `md` and writes it to the `--markdown` file, if one was given.
+pub fn print_markdown(md: &str, path: Option<&Path>) -> Result<(), String> {
+    print!("{md}");
+    path.map_or(Ok(()), |p| write_text("--markdown", p, md))
+}
+
+/// Writes `value` to the `--json` file `path`, indented, with a final newline.
+pub fn write_json(path: &Path, value: &Value) -> Result<(), String> {
+    write_text("--json", path, &format!("{value:#}\n"))
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::json;
+
+    use super::*;
+
+    /// The JSON file parses back to the value; a file that cannot be written names the flag and the path.
+    #[test]
+    fn writes_json_and_names_flag_and_file_on_error() {
+        let dir = std::env::temp_dir().join(format!("raylab-output-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("out.json");
+        let v = json!({ "fps": 12.5, "rows": [1, 2] });
+        write_json(&path, &v).unwrap();
+        let back = std::fs::read_to_string(&path).unwrap();
+        assert!(back.ends_with('\n'));
+        assert_eq!(serde_json::from_str::<Value>(&back).unwrap(), v);
+        let missing = dir.join("no/such/dir/t.md");
+        let err = write_text("--markdown", &missing, "x").unwrap_err();
+        assert!(err.starts_with("--markdown: cannot write ") && err.contains("t.md"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
