@@ -5,6 +5,14 @@ use std::path::Path;
 
 use serde_json::Value;
 
+use crate::env::Environment;
+
+/// The opening lines of every markdown report: the machine and build it ran on, and the exact command line
+/// `cmd`, so that a table in docs/BENCHMARKS.md says how to make it again.
+pub fn markdown_header(env: &Environment, cmd: &[String]) -> String {
+    format!("Machine and build: {}.\nCommand: `{}`\n", env.line(), cmd.join(" "))
+}
+
 /// Writes `text` to the file `path` given with `flag` (such as `--markdown`).
 pub fn write_text(flag: &str, path: &Path, text: &str) -> Result<(), String> {
     std::fs::write(path, text).map_err(|e| format!("{flag}: cannot write {}: {e}", path.display()))

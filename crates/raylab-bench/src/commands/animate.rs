@@ -21,7 +21,7 @@ use serde_json::json;
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_non_negative};
 use crate::env::Environment;
-use crate::output::{print_markdown, write_json};
+use crate::output::{markdown_header, print_markdown, write_json};
 use crate::prepare::load_scene;
 use crate::timing::{DACRT_SET_TILE, HARNESS_TILE, summarize, trace_once, validate};
 
@@ -125,10 +125,8 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
             return Err(format!("frame {f}: the methods disagree on the hit count: {checksums:?}"));
         }
     }
-    let mut md = String::new();
     let cmd: Vec<String> = std::env::args().collect();
-    let _ = writeln!(md, "Machine and build: {}.", env.line());
-    let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
+    let mut md = markdown_header(&env, &cmd);
     let _ = writeln!(
         md,
         "\n{} ({} triangles, {} of them moving), {} {} rays a frame, {} frames, {} thread(s); medians per frame.\n",

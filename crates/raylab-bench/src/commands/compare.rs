@@ -23,7 +23,7 @@ use serde_json::json;
 
 use crate::args::{ImageArgs, KdArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
-use crate::output::{print_markdown, write_json};
+use crate::output::{markdown_header, print_markdown, write_json};
 use crate::prepare::{build_tree, load_scene, with_spinner};
 use crate::timing::{DACRT_SET_TILE as DACRT_TILE, HARNESS_TILE, TraceReport, measure, tile_for_group, validate};
 
@@ -320,10 +320,8 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     embree.combine(&embree_rounds);
     let Round { ours, coherent, incoherent } = Round::combine(&rounds);
 
-    let mut md = String::new();
     let cmd: Vec<String> = std::env::args().collect();
-    let _ = writeln!(md, "Machine and build: {}.", env.line());
-    let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
+    let mut md = markdown_header(&env, &cmd);
     let _ = writeln!(md, "\nEmbree harness checks: {}.\n", embree.checks.join("; "));
     let _ = writeln!(
         md,

@@ -15,7 +15,7 @@ use serde_json::json;
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_non_negative};
 use crate::env::Environment;
-use crate::output::{print_markdown, write_json};
+use crate::output::{markdown_header, print_markdown, write_json};
 use crate::prepare::{build_tree, load_scene, with_spinner};
 
 /// Traces the distribution workload with each method and prints per-bounce speeds and counters.
@@ -102,10 +102,8 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
         let stats = pool.install(|| render_pass(&scene, &tracer, &camera, light, &s, 0, &mut acc));
         (stats, acc, t0.elapsed().as_secs_f64())
     };
-    let mut md = String::new();
     let cmd: Vec<String> = std::env::args().collect();
-    let _ = writeln!(md, "Machine and build: {}.", env.line());
-    let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
+    let mut md = markdown_header(&env, &cmd);
     let _ = writeln!(
         md,
         "\n{}: {}x{}, {} paths per pixel, {} bounces, {}, Phong exponent {}, {} thread(s); speeds are per \

@@ -20,7 +20,7 @@ use serde_json::{Value, json};
 use super::shading_tables::{ShadingRun, Subject};
 use crate::args::{KdArgs, SceneArgs, in_range};
 use crate::env::Environment;
-use crate::output::{print_markdown, write_json};
+use crate::output::{markdown_header, print_markdown, write_json};
 use crate::prepare::{build_tree, load_scene};
 
 /// Regenerates thesis Tables 4.1-4.5 for the built-in scenes and the scene given with `--scene` (for
@@ -267,10 +267,8 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
         records.extend(r.mft_cone.iter().zip(tiles).map(|(c, t)| cell("4.5", Method::MftCone, t, true, c)));
     }
 
-    let mut md = String::new();
     let cmd: Vec<String> = std::env::args().collect();
-    let _ = writeln!(md, "Machine and build: {}.", env.line());
-    let _ = writeln!(md, "Command: `{}`", cmd.join(" "));
+    let mut md = markdown_header(&env, &cmd);
     if primary {
         let _ = writeln!(
             md,
