@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use serde_json::Value;
+use serde_json::{Value, json};
 
 use crate::env::Environment;
 
@@ -24,28 +24,34 @@ pub fn print_markdown(md: &str, path: Option<&Path>) -> Result<(), String> {
     path.map_or(Ok(()), |p| write_text("--markdown", p, md))
 }
 
-/// Writes `value` to the `--json` file `path`, indented, with a final newline.
-pub fn write_json(path: &Path, value: &Value) -> Result<(), String> {
-    write_text("--json", path, &format!("{value:#}\n"))
+/// Writes the report `body` (a JSON object) to the `--json` file `path`, indented, with a final newline,
+/// adding the machine and build (`environment`) and the exact command line (`command`), as every markdown
+/// report opens with them ([`markdown_header`]).
+pub fn write_json(path: &Path, env: &Environment, cmd: &[String], mut body: Value) -> Result<(), String> {
+    if let Some(o) = body.as_object_mut() {
+        o.insert("environment".into(), json!(env));
+        o.insert("command".into(), json!(cmd));
+    }
+    write_text("--json", path, &format!("{body:#}\n"))
 }
 
 #[cfg(test)]
 mod tests {
-    use serde_json::json;
-
     use super::*;
 
-    /// The JSON file parses back to the value; a file that cannot be written names the flag and the path.
+    /// The JSON file parses back to the report with the machine and the command added; a file that cannot be
+    /// written names the flag and the path.
     #[test]
     fn writes_json_and_names_flag_and_file_on_error() {
         let dir = std::env::temp_dir().join(format!("raylab-output-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("out.json");
-        let v = json!({ "fps": 12.5, "rows": [1, 2] });
-        write_json(&path, &v).unwrap();
+        let (env, cmd) = (Environment::detect(), vec!["raylab-bench".to_string(), "tables".to_string()]);
+        write_json(&path, &env, &cmd, json!({ "fps": 12.5, "rows": [1, 2] })).unwrap();
         let back = std::fs::read_to_string(&path).unwrap();
         assert!(back.ends_with('\n'));
-        assert_eq!(serde_json::from_str::<Value>(&back).unwrap(), v);
+        let want = json!({ "fps": 12.5, "rows": [1, 2], "environment": env, "command": cmd });
+        assert_eq!(serde_json::from_str::<Value>(&back).unwrap(), want);
         let missing = dir.join("no/such/dir/t.md");
         let err = write_text("--markdown", &missing, "x").unwrap_err();
         assert!(err.starts_with("--markdown: cannot write ") && err.contains("t.md"), "{err}");

@@ -240,6 +240,8 @@ fn tables_print_the_thesis_tables() {
     // The same tables as flat JSON records, one per measured cell.
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.path().join("tables.json")).unwrap()).unwrap();
     let records = v["records"].as_array().unwrap_or_else(|| panic!("{v}"));
+    assert!(v["environment"]["cpus"].as_u64().is_some_and(|n| n > 0), "the machine is named: {v}");
+    assert_eq!(v["command"][1], "tables", "the command line is quoted: {v}");
     let of = |table: &str| records.iter().filter(|r| r["table"] == table).collect::<Vec<_>>();
     let counts = ["4.1", "4.2", "4.3", "4.5", "5.1", "4.6", "3.1", "quality"].map(|t| of(t).len());
     assert_eq!(counts, [5, 1, 4, 6, 6, 8, 1, 6], "{v}");

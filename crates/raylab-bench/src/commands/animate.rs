@@ -155,8 +155,6 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
     print_markdown(&md, a.markdown.as_deref())?;
     if let Some(p) = &a.json {
         let v = json!({
-            "environment": env,
-            "command": cmd,
             "scene": a.scene.scene,
             "triangles": scene.triangle_count(),
             "moving_triangles": anim.moving_triangles(),
@@ -179,7 +177,7 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
                 })
             }).collect::<Vec<_>>(),
         });
-        write_json(p, &v)?;
+        write_json(p, &env, &cmd, v)?;
     }
     Ok(())
 }

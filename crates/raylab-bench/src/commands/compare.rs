@@ -450,8 +450,6 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     print_markdown(&md, a.markdown.as_deref())?;
     if let Some(p) = &a.json {
         let v = json!({
-            "environment": env,
-            "command": cmd,
             "scene": a.scene.scene,
             "camera": cam,
             "light": light.position.to_array(),
@@ -483,7 +481,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                 .collect::<Vec<_>>(),
             "dacrt_setup_seconds": dacrt_setup,
         });
-        write_json(p, &v)?;
+        write_json(p, &env, &cmd, v)?;
     }
     Ok(())
 }

@@ -135,8 +135,6 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
     print_markdown(&md, a.markdown.as_deref())?;
     if let Some(p) = &a.json {
         let v = json!({
-            "environment": env,
-            "command": cmd,
             "scene": scene_name,
             "camera": camera,
             "light": light,
@@ -158,7 +156,7 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
                 })).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
         });
-        write_json(p, &v)?;
+        write_json(p, &env, &cmd, v)?;
     }
     if let (Some(out), Some(acc)) = (&a.out, first_image) {
         image::RgbaImage::from_raw(acc.width, acc.height, acc.rgba().as_flattened().to_vec())

@@ -406,8 +406,6 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
     print_markdown(&md, a.markdown.as_deref())?;
     if let Some(p) = &a.json {
         let v = json!({
-            "environment": env,
-            "command": cmd,
             "width": a.width,
             "height": a.height,
             "threads": a.threads,
@@ -416,7 +414,7 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
             "kd_params": params,
             "records": records,
         });
-        write_json(p, &v)?;
+        write_json(p, &env, &cmd, v)?;
     }
     Ok(())
 }
