@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Writes the "targets" section of docs/BENCHMARKS.md: each benchmark target of the open issues beside the
-figure measured for it, read from the tables the benchmark scripts wrote (never typed), with the commit of
-the table it comes from.
+"""Writes the "targets" section of docs/BENCHMARKS.md: each benchmark target of the issues beside the figure
+measured for it, read from the tables the benchmark scripts wrote (never typed), with the commit of the
+table it comes from.
 
     python3 scripts/targets.py           # rewrites the section in place
     python3 scripts/targets.py --check   # exits 1 when the section differs from what the tables give
