@@ -10,7 +10,7 @@ cost in `run_avx2` and in the intrinsics' source files; this says which raylab l
     scripts/callgrind-lines.py cg.out target/release/raylab-bench [FRAGMENT ...]
 
 FRAGMENT defaults to `crates/raylab-core/`. Prints the share of the profile's cost per function (with its
-file), then per source line. Needs `addr2line` (binutils) and a binary with line tables (the release
+file) for every function with a thousandth of it or more, then for the 40 costliest source lines. Needs `addr2line` (binutils) and a binary with line tables (the release
 profile keeps them)."""
 import collections
 import re
@@ -81,7 +81,10 @@ def main():
         by_func[f"{name} ({loc.split(':')[0]})"] += costs[a]
         by_line[loc] += costs[a]
     print(f"total {total:,}")
-    for k, v in by_func.most_common(30):
+    # Every function down to a thousandth of the profile, so that sums over a group of them miss little.
+    for k, v in by_func.most_common():
+        if v * 1000 < total:
+            break
         print(f"{100 * v / total:5.1f}% {v:>13,}  {k}")
     print("--- lines")
     for k, v in by_line.most_common(40):
