@@ -10,8 +10,8 @@ cost in `run_avx2` and in the intrinsics' source files; this says which raylab l
     scripts/callgrind-lines.py cg.out target/release/raylab-bench [FRAGMENT ...]
 
 FRAGMENT defaults to `crates/raylab-core/`. Prints the share of the profile's cost per function (with its
-file) for every function with a thousandth of it or more, then for the 40 costliest source lines. Needs `addr2line` (binutils) and a binary with line tables (the release
-profile keeps them)."""
+file) for every function with a thousandth of it or more, then for the 40 costliest source lines. Needs
+`addr2line` (binutils) and a binary with line tables (the release profile keeps them)."""
 import collections
 import re
 import signal
