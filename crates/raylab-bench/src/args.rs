@@ -3,10 +3,10 @@
 use clap::Args;
 use glam::Vec3;
 use raylab_core::kdtree::KdParams;
-use raylab_core::method::Method;
 use raylab_core::render::RenderSettings;
 use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::shadow::{SampleBound, ShadowKind, Shadows};
+use raylab_core::structures::StructureParams;
 use raylab_scene::SceneSource;
 
 /// Parses `X,Y,Z`.
@@ -182,7 +182,7 @@ impl ImageArgs {
     }
 }
 
-/// kd-tree cost-model flags (thesis Eq. 2.1); the defaults are [`KdParams::for_method`]'s.
+/// kd-tree cost-model flags (thesis Eq. 2.1); the defaults are [`StructureParams::default`]'s.
 #[derive(Args, Clone, Debug)]
 pub struct KdArgs {
     /// Traversal cost C_traversal of the SAH [default: 12 for the trees of packet, frustum, mft, cone and
@@ -201,25 +201,26 @@ pub struct KdArgs {
 }
 
 impl KdArgs {
-    /// The parameters of the thesis's tree (the one that single rays and the thesis's tables use), with
-    /// the flags' changes; checked, and the error names the flag.
-    pub fn params(&self) -> Result<KdParams, String> {
-        self.params_for(Method::Mono)
-    }
-
-    /// The parameters of the tree that `method` walks ([`KdParams::for_method`]), with the flags' changes;
-    /// checked, and the error names the flag.
-    pub fn params_for(&self, method: Method) -> Result<KdParams, String> {
-        let base = KdParams::for_method(method);
-        let p = KdParams {
+    /// The parameters of every structure: both kd-trees' cost models ([`StructureParams::default`]) with the
+    /// flags' changes (`--kd-ctrav` sets both trees' `c_trav`); checked, and the error names the flag.
+    pub fn structure_params(&self) -> Result<StructureParams, String> {
+        let with_flags = |base: KdParams| KdParams {
             c_trav: self.kd_ctrav.unwrap_or(base.c_trav),
             c_isect: self.kd_cisect,
             empty_bonus: self.kd_empty_bonus,
             max_depth: self.kd_max_depth.map(|d| d as u32),
             ..base
         };
+        let defaults = StructureParams::default();
+        let p = StructureParams { kd: with_flags(defaults.kd), packet_kd: with_flags(defaults.packet_kd), ..defaults };
         p.validate().map_err(|m| format!("--kd-*: {m}"))?;
         Ok(p)
+    }
+
+    /// The parameters of the thesis's tree (the one that single rays and the thesis's tables use), with
+    /// the flags' changes; checked, and the error names the flag.
+    pub fn params(&self) -> Result<KdParams, String> {
+        Ok(self.structure_params()?.kd)
     }
 }
 

@@ -4,7 +4,9 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use raylab_core::kdtree::{KdParams, KdTree};
+use raylab_core::method::{Method, Purpose};
 use raylab_core::scene::Scene;
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_scene::SceneSource;
 
 /// Runs `f` while a spinner with `msg` turns on stderr (hidden when stderr is not a terminal).
@@ -40,6 +42,22 @@ pub fn load_scene_verbose(source: &SceneSource) -> Result<(raylab_scene::Loaded,
     let loaded = raylab_scene::load_with_progress(source, &|done| bar.set_position((done * 1000.0) as u64));
     bar.finish_and_clear();
     Ok((loaded.map_err(|e| e.to_string())?, t0.elapsed().as_secs_f64()))
+}
+
+/// Builds the structures `methods` need for `purpose` on a pool of `threads` threads.
+pub fn build_structures(
+    scene: &Scene,
+    methods: &[Method],
+    purpose: Purpose,
+    params: &StructureParams,
+    threads: usize,
+) -> Result<Structures, String> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
+    with_spinner("building structures", || pool.install(|| Structures::build(scene, methods, purpose, params)))
+        .map_err(|e| e.to_string())
 }
 
 /// Builds the kd-tree on a pool of `threads` threads.

@@ -1,27 +1,24 @@
 //! One still frame exactly as `raylab-bench render` makes it: the scene, view and light from the flags, a
-//! kd-tree, and the tile renderer on a pool of the given size. The viewer's tests compare its window
+//! method's structures, and the tile renderer on a pool of the given size. The viewer's tests compare its window
 //! against this image.
 
 use std::time::Instant;
 
-use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::mbvh::Mbvh;
-use raylab_core::method::Method;
-use raylab_core::reference::BruteForce;
+use raylab_core::method::Purpose;
 use raylab_core::render::{Frame, RenderSettings, render};
 use raylab_core::scene::{Camera, PointLight, Scene};
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::trace::{TraceOptions, Tracer};
 
 use crate::args::SceneArgs;
-use crate::prepare::{build_tree, load_scene};
+use crate::prepare::{build_structures, load_scene};
 
 /// A rendered still and what it took.
 pub struct Still {
     /// The scene.
     pub scene: Scene,
-    /// Its kd-tree.
-    pub tree: KdTree,
+    /// The structures its method traced through.
+    pub structures: Structures,
     /// The camera the frame was rendered from (the scene's view with the flags' overrides).
     pub camera: Camera,
     /// The light it was lit by.
@@ -32,7 +29,7 @@ pub struct Still {
     pub load_s: f64,
     /// Seconds spent rendering: the median over the frames rendered.
     pub render_s: f64,
-    /// Seconds each rendered frame took, in order (the first includes setting up MBVH or DACRT).
+    /// Seconds each rendered frame took, in order.
     pub frame_s: Vec<f64>,
 }
 
@@ -42,7 +39,7 @@ pub struct Still {
 /// carries the stage times of the median frame.
 pub fn render_still(
     scene: &SceneArgs,
-    kd: &KdParams,
+    params: &StructureParams,
     options: TraceOptions,
     settings: impl FnOnce(&PointLight) -> RenderSettings,
     threads: usize,
@@ -52,27 +49,10 @@ pub fn render_still(
     let (camera, light) = scene.camera_and_light(&loaded)?;
     let settings = &settings(&light);
     settings.shadows.validate().map_err(|e| format!("--shadows: {e}"))?;
-    let tree = build_tree(&loaded, kd, threads)?;
+    let structures = build_structures(&loaded, &[options.method], Purpose::Frames, params, threads)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
+    let tracer = Tracer::new(&structures, options).map_err(|e| e.to_string())?;
     let t0 = Instant::now();
-    let reference = (options.method == Method::Reference).then(|| BruteForce::new(&loaded));
-    let mbvh = options.method.uses_mbvh().then(|| {
-        let mut m = pool.install(|| Mbvh::build(&loaded));
-        m.backend = options.backend;
-        m
-    });
-    let dacrt = options.method.uses_dacrt().then(|| {
-        let mut d = Dacrt::new(&loaded);
-        d.backend = options.backend;
-        d
-    });
-    let mut tracer = Tracer::new(&tree, reference.as_ref(), options);
-    if let Some(m) = &mbvh {
-        tracer = tracer.with_mbvh(m);
-    }
-    if let Some(d) = &dacrt {
-        tracer = tracer.with_dacrt(d);
-    }
     let mut timed = Vec::with_capacity(frames.max(1));
     let mut frame = pool.install(|| render(&loaded, &tracer, &camera, light, settings));
     timed.push((t0.elapsed().as_secs_f64(), frame.stages));
@@ -85,7 +65,7 @@ pub fn render_still(
     timed.sort_by(|a, b| a.0.total_cmp(&b.0));
     let (render_s, stages) = timed[timed.len() / 2];
     frame.stages = stages;
-    Ok(Still { scene: loaded, tree, camera, light, frame, load_s, render_s, frame_s })
+    Ok(Still { scene: loaded, structures, camera, light, frame, load_s, render_s, frame_s })
 }
 
 impl Still {

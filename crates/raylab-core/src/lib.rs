@@ -11,6 +11,7 @@
 pub mod aabb;
 pub mod dacrt;
 pub mod distribution;
+pub mod intersector;
 pub mod kdtree;
 pub mod mbvh;
 pub mod method;
@@ -21,6 +22,7 @@ pub mod render;
 pub mod scene;
 pub mod shadow;
 pub mod stats;
+pub mod structures;
 pub mod trace;
 pub mod tri4;
 pub mod triangle;

@@ -5,13 +5,6 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use crate::dacrt::{Dacrt, DacrtParams};
-use crate::kdtree::KdTree;
-use crate::mbvh::Mbvh;
-use crate::ray::{Hit, Ray};
-use crate::reference::BruteForce;
-use crate::stats::TraversalStats;
-
 /// A way of tracing rays; the CLI's `--method` and the viewer's method list.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -116,6 +109,74 @@ impl Method {
     }
 }
 
+/// A structure a method traces through; [`crate::structures::Structures`] builds them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Structure {
+    /// The kd-tree with the thesis's cost model (thesis 2.2.1, Eq. 2.1, `c_trav` 1).
+    ThesisKd,
+    /// The kd-tree with the packet methods' cost model (`c_trav` [`crate::kdtree::KdParams::PACKET_C_TRAV`]).
+    PacketKd,
+    /// The 4-wide BVH (MBVH RS paper, section 2).
+    Mbvh,
+    /// The triangles prepared for divide-and-conquer tracing (seed 003).
+    Dacrt,
+    /// The brute-force reference.
+    Reference,
+}
+
+impl Structure {
+    /// The name reports and errors use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Structure::ThesisKd => "kd-tree",
+            Structure::PacketKd => "packet kd-tree",
+            Structure::Mbvh => "MBVH",
+            Structure::Dacrt => "DACRT preparation",
+            Structure::Reference => "brute-force reference",
+        }
+    }
+}
+
+/// What a set of structures is for: tracing rays only, or rendering frames, whose shadow techniques walk more.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Purpose {
+    /// Closest and any hits of ray tiles (`raylab-bench trace`).
+    Rays,
+    /// Whole frames: also edge-width soft shadows and sampled shadows' bundles.
+    Frames,
+}
+
+impl Method {
+    /// The structure this method's ray kernels walk.
+    pub fn kernel_structure(self) -> Structure {
+        match self {
+            Method::Mono => Structure::ThesisKd,
+            Method::Packet | Method::Frustum | Method::Mft | Method::Cone | Method::MftCone => Structure::PacketKd,
+            Method::Mbvh | Method::MbvhRs => Structure::Mbvh,
+            Method::Dacrt => Structure::Dacrt,
+            Method::Reference => Structure::Reference,
+        }
+    }
+
+    /// The kd-tree this method's frames walk besides its kernel's structure: the edge-width walks (thesis
+    /// Listing 5.1) and sampled shadows' packet and frustum walks (thesis chapter 5) need leaves in distance order,
+    /// which the MBVH and DACRT do not give, so those methods walk the thesis's kd-tree for them. The kd-tree
+    /// methods use their own tree, and the reference answers every query itself.
+    pub fn frame_kd(self) -> Option<Structure> {
+        match self.kernel_structure() {
+            Structure::ThesisKd | Structure::PacketKd => Some(self.kernel_structure()),
+            Structure::Mbvh | Structure::Dacrt => Some(Structure::ThesisKd),
+            Structure::Reference => None,
+        }
+    }
+
+    /// The structures this method needs for `purpose`: its kernel's, and for frames its [`Method::frame_kd`].
+    pub fn structures(self, purpose: Purpose) -> impl Iterator<Item = Structure> {
+        let frame_kd = if purpose == Purpose::Frames { self.frame_kd() } else { None };
+        std::iter::once(self.kernel_structure()).chain(frame_kd)
+    }
+}
+
 impl fmt::Display for Method {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -129,55 +190,5 @@ impl FromStr for Method {
             let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
             format!("unknown method '{s}' (valid: {})", names.join(", "))
         })
-    }
-}
-
-/// Closest-hit and any-hit queries on single rays, implemented by every acceleration structure.
-pub trait Intersector: Sync {
-    /// The closest hit in `(tmin, tmax]`.
-    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit>;
-    /// True when anything blocks the ray in `(tmin, tmax]`.
-    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool;
-}
-
-impl Intersector for KdTree {
-    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        KdTree::intersect(self, ray, stats)
-    }
-    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        KdTree::occluded(self, ray, stats)
-    }
-}
-
-impl Intersector for Mbvh {
-    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        Mbvh::intersect(self, ray, stats)
-    }
-    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        Mbvh::occluded(self, ray, stats)
-    }
-}
-
-impl Intersector for BruteForce {
-    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        BruteForce::intersect(self, ray, stats)
-    }
-    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        BruteForce::occluded(self, ray, stats)
-    }
-}
-
-/// One ray traced as a set of one with the default parameters: correct, but DACRT's cost is amortised over large sets
-/// ([`Dacrt::intersect`]); this serves the shared per-ray tests.
-impl Intersector for Dacrt {
-    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        let mut out = [None];
-        Dacrt::intersect(self, &DacrtParams::default(), &[Some(*ray)], &mut out, stats);
-        out[0]
-    }
-    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        let mut out = [false];
-        Dacrt::occluded(self, &DacrtParams::default(), &[Some(*ray)], &mut out, stats);
-        out[0]
     }
 }

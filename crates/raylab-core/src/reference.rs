@@ -3,6 +3,7 @@
 //! Slow by design and obviously correct; every traversal method is tested against it ("always keep a
 //! reference implementation", Akenine-Moller and Assarsson, Ray Tracing II).
 
+use crate::intersector::Intersector;
 use crate::ray::{Hit, Ray};
 use crate::scene::Scene;
 use crate::shadow::{Crossing, EdgeWidth};
@@ -19,6 +20,11 @@ impl BruteForce {
     /// Prepares the triangles of `scene`.
     pub fn new(scene: &Scene) -> Self {
         Self { tris: TriangleSoup::from_scene(scene) }
+    }
+
+    /// Bytes of its triangle copy.
+    pub fn bytes(&self) -> usize {
+        self.tris.len() * std::mem::size_of::<[crate::Vec3; 3]>()
     }
 
     /// The closest hit in `(tmin, tmax]`; among hits at the same distance the lowest triangle id wins.
@@ -89,5 +95,14 @@ impl BruteForce {
     pub fn hit_distance(&self, ray: &Ray, tri: u32) -> Option<f32> {
         let t = self.tris.as_slice().get(tri as usize)?;
         RayShear::new(ray).intersect(t, ray.tmin, ray.tmax).map(|h| h.t)
+    }
+}
+
+impl Intersector for BruteForce {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        BruteForce::intersect(self, ray, stats)
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        BruteForce::occluded(self, ray, stats)
     }
 }

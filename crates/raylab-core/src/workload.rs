@@ -13,7 +13,7 @@ use std::str::FromStr;
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::method::Intersector;
+use crate::intersector::Intersector;
 use crate::ray::{Hit, Ray};
 use crate::scene::{Camera, Scene};
 use crate::stats::TraversalStats;

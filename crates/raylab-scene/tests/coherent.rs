@@ -3,11 +3,12 @@
 //! on every built-in scene and on adversarial cameras.
 
 use glam::Vec3;
-use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::method::Method;
+use raylab_core::kdtree::KdParams;
+use raylab_core::method::{Method, Purpose, Structure};
 use raylab_core::ray::{Hit, Ray};
 use raylab_core::scene::{Camera, Scene};
 use raylab_core::stats::TraversalStats;
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 use raylab_scene::builtin::{self, Detail};
@@ -57,24 +58,28 @@ fn same_hit(got: Option<Hit>, want: Option<Hit>) -> bool {
 }
 
 /// Compares every method against mono on the primary and shadow rays of one view: on mono's tree (the
-/// thesis's cost model), and also on the tree built for the packet methods ([`KdParams::for_method`]),
+/// thesis's cost model), and also on the tree built for the packet methods ([`StructureParams::packet_kd`]),
 /// whose leaves are larger.
 fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what: &str) {
-    let tree = KdTree::build(scene, &KdParams::default()).unwrap();
-    let packet_tree = KdTree::build(scene, &KdParams::for_method(Method::Mft)).unwrap();
+    let all: Vec<Method> = METHODS.into_iter().chain([Method::Mono]).collect();
+    let own = Structures::build(scene, &all, Purpose::Frames, &StructureParams::default()).unwrap();
+    // Every method on the thesis's tree: both kd-tree slots take its cost model.
+    let thesis_params = StructureParams { packet_kd: KdParams::default(), ..StructureParams::default() };
+    let thesis = Structures::build(scene, &METHODS, Purpose::Frames, &thesis_params).unwrap();
+    let (tree, packet_tree) = (own.kd(Structure::ThesisKd).unwrap(), own.kd(Structure::PacketKd).unwrap());
     if scene.triangles.len() > 1000 {
         // Otherwise the second tree would test nothing new.
         assert!(packet_tree.nodes().len() < tree.nodes().len(), "{what}: the packet methods' tree is not coarser");
     }
-    let wb = WorkloadBuilder::new(scene, cam, light, w as u32, h as u32, &tree);
+    let wb = WorkloadBuilder::new(scene, cam, light, w as u32, h as u32, tree);
     let primary = wb.build(RayKind::Primary).rays;
     let shadow = wb.build(RayKind::Shadow).rays;
-    let mono = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
+    let mono = Tracer::new(&own, TraceOptions { method: Method::Mono, ..Default::default() }).unwrap();
     let (want_hits, _) = trace_image(&mono, &primary, w, h, 8, None);
     let (_, want_occ) = trace_image(&mono, &shadow, w, h, 8, Some(light));
     let walks = METHODS.into_iter().flat_map(|m| {
-        let own = m.uses_packets().then_some((m, &packet_tree, "own tree"));
-        [Some((m, &tree, "mono's tree")), own].into_iter().flatten()
+        let own_tree = m.uses_packets().then_some((m, &own, "own tree"));
+        [Some((m, &thesis, "mono's tree")), own_tree].into_iter().flatten()
     });
     for (method, walked, which) in walks {
         for backend in Backend::available() {
@@ -85,7 +90,7 @@ fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what
                     // An infinite spread limit sends every shadow tile down the frustum path.
                     let opts =
                         TraceOptions { method, cull, backend, shadow_spread_limit: spread, ..TraceOptions::default() };
-                    let tracer = Tracer::new(walked, None, opts);
+                    let tracer = Tracer::new(walked, opts).unwrap();
                     let (hits, _) = trace_image(&tracer, &primary, w, h, tile, None);
                     let (_, occ) = trace_image(&tracer, &shadow, w, h, tile, Some(light));
                     for i in 0..w * h {
@@ -159,13 +164,15 @@ fn shadow_rays_from_a_light_on_a_split_plane() {
 fn rendered_frames_are_identical_for_every_method() {
     use raylab_core::render::{RenderSettings, render};
     let scene = builtin::build("atrium", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let thesis_params = StructureParams { packet_kd: KdParams::default(), ..StructureParams::default() };
+    let methods = [Method::Mono, Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone];
+    let structures = Structures::build(&scene, &methods, Purpose::Frames, &thesis_params).unwrap();
     let cam = scene.default_view().unwrap().camera;
     let light = scene.lights[0];
     let mut frames = Vec::new();
-    for method in [Method::Mono, Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone] {
+    for method in methods {
         for tile in [4, 16] {
-            let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
+            let tracer = Tracer::new(&structures, TraceOptions { method, ..Default::default() }).unwrap();
             let settings = RenderSettings { width: 61, height: 43, tile, ..Default::default() };
             frames.push((method, tile, render(&scene, &tracer, &cam, light, &settings).rgba));
         }
@@ -183,9 +190,11 @@ fn invalid_rays_in_a_tile_are_ignored() {
     let scene = builtin::build("arena", Detail::Test).unwrap();
     let cam = scene.default_view().unwrap().camera;
     let light = scene.lights[0].position;
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let thesis_params = StructureParams { packet_kd: KdParams::default(), ..StructureParams::default() };
+    let structures = Structures::build(&scene, &METHODS, Purpose::Frames, &thesis_params).unwrap();
+    let tree = structures.kd(Structure::ThesisKd).unwrap();
     let (w, h) = (16, 16);
-    let mut rays = WorkloadBuilder::new(&scene, &cam, light, w as u32, h as u32, &tree).build(RayKind::Primary).rays;
+    let mut rays = WorkloadBuilder::new(&scene, &cam, light, w as u32, h as u32, tree).build(RayKind::Primary).rays;
     let o = cam.eye;
     let bad = [
         Ray::new(o, Vec3::ZERO),
@@ -197,7 +206,7 @@ fn invalid_rays_in_a_tile_are_ignored() {
     for (k, i) in (0..w * h).step_by(7).enumerate() {
         rays[i] = Some(bad[k % bad.len()]);
     }
-    let mono = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
+    let mono = Tracer::new(&structures, TraceOptions { method: Method::Mono, ..Default::default() }).unwrap();
     let (want_hits, want_occ) = trace_image(&mono, &rays, w, h, 8, None);
     for (k, i) in (0..w * h).step_by(7).enumerate() {
         assert!(want_hits[i].is_none() && !want_occ[i], "mono traced bad ray {k}");
@@ -205,7 +214,8 @@ fn invalid_rays_in_a_tile_are_ignored() {
     for method in METHODS {
         for backend in Backend::available() {
             for tile in [4, 8, 16] {
-                let tracer = Tracer::new(&tree, None, TraceOptions { method, backend, ..TraceOptions::default() });
+                let opts = TraceOptions { method, backend, ..TraceOptions::default() };
+                let tracer = Tracer::new(&structures, opts).unwrap();
                 let (hits, occ) = trace_image(&tracer, &rays, w, h, tile, None);
                 for i in 0..w * h {
                     assert!(same_hit(hits[i], want_hits[i]), "{method} {backend:?} tile {tile} pixel {i}");

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{adversarial_rays, check_hits, incoherent, scaled_scenes};
+use common::{Lanes, adversarial_rays, check_hits, incoherent, scaled_scenes};
 use glam::Vec3;
 use raylab_core::dacrt::{Dacrt, DacrtParams, SplitRule};
 use raylab_core::kdtree::{KdParams, KdTree};
@@ -36,7 +36,15 @@ fn mixed_rays(
 
 /// Traces `rays` with `d` in sets of `set` rays and checks closest hits, occlusion and blockers against
 /// brute force. Returns the counters.
-fn check_sets(scene: &Scene, d: &Dacrt, p: &DacrtParams, rays: &[Ray], set: usize, what: &str) -> TraversalStats {
+fn check_sets(
+    scene: &Scene,
+    d: &Lanes<Dacrt>,
+    p: &DacrtParams,
+    rays: &[Ray],
+    set: usize,
+    what: &str,
+) -> TraversalStats {
+    let Lanes(d, backend) = *d;
     let bf = BruteForce::new(scene);
     let mut s = TraversalStats::default();
     let all: Vec<Option<Ray>> = rays.iter().copied().map(Some).collect();
@@ -44,9 +52,9 @@ fn check_sets(scene: &Scene, d: &Dacrt, p: &DacrtParams, rays: &[Ray], set: usiz
         let mut hits = vec![None; chunk.len()];
         let mut blocked = vec![false; chunk.len()];
         let mut blockers = vec![None; chunk.len()];
-        d.intersect(p, chunk, &mut hits, &mut s);
-        d.occluded(p, chunk, &mut blocked, &mut s);
-        d.occluders(p, chunk, &mut blockers, &mut s);
+        d.intersect(p, backend, chunk, &mut hits, &mut s);
+        d.occluded(p, backend, chunk, &mut blocked, &mut s);
+        d.occluders(p, backend, chunk, &mut blockers, &mut s);
         for (i, r) in chunk.iter().enumerate() {
             let r = r.unwrap();
             let at = format!("{what}, set {c} ray {i} {r:?}");
@@ -71,11 +79,11 @@ fn dacrt_matches_brute_force_on_every_builtin_scene() {
     for name in builtin::names() {
         let scene = builtin::build(name, Detail::Test).unwrap();
         let rays = mixed_rays(&scene, (150, 3), (2500, 11));
-        let mut d = Dacrt::new(&scene);
+        let d = Dacrt::new(&scene);
         let p = DacrtParams::default();
         for backend in Backend::available() {
-            d.backend = backend;
-            let s = check_sets(&scene, &d, &p, &rays, rays.len(), &format!("{name} {}", backend.name()));
+            let s =
+                check_sets(&scene, &Lanes(&d, backend), &p, &rays, rays.len(), &format!("{name} {}", backend.name()));
             assert_eq!(s.rays, 3 * rays.len() as u64);
             // Filtering and leaves do the work: far fewer tests than brute force.
             let brute = (rays.len() * scene.triangle_count()) as u64;
@@ -83,8 +91,8 @@ fn dacrt_matches_brute_force_on_every_builtin_scene() {
             assert!(s.nodes > 0 && s.leaves > 0 && s.box_tests > 0);
         }
         // Small sets, down to single rays.
-        check_sets(&scene, &d, &p, &rays[..300], 7, name);
-        check_hits(&scene, &d, &rays[..100], name);
+        check_sets(&scene, &Lanes(&d, Backend::detect()), &p, &rays[..300], 7, name);
+        check_hits(&scene, &Lanes(&d, Backend::detect()), &rays[..100], name);
     }
 }
 
@@ -100,9 +108,13 @@ fn small_sets_give_the_same_hits_forked_and_on_one_thread() {
     for threads in [1, 2, 3] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         let what = format!("{threads} threads");
-        let s = pool.install(|| check_sets(&scene, &d, &DacrtParams::default(), &rays, rays.len(), &what));
+        let s = pool.install(|| {
+            check_sets(&scene, &Lanes(&d, Backend::detect()), &DacrtParams::default(), &rays, rays.len(), &what)
+        });
         assert_eq!(s.rays, 3 * rays.len() as u64, "{what}");
-        let singles = pool.install(|| check_sets(&scene, &d, &DacrtParams::default(), &rays[..40], 1, &what));
+        let singles = pool.install(|| {
+            check_sets(&scene, &Lanes(&d, Backend::detect()), &DacrtParams::default(), &rays[..40], 1, &what)
+        });
         assert_eq!(singles.rays, 3 * 40, "{what}");
     }
 }
@@ -127,8 +139,8 @@ fn the_division_made_at_setup_gives_the_same_hits() {
         for split in SplitRule::ALL {
             let p = DacrtParams { split, ..DacrtParams::default() };
             let what = format!("{split:?} on {threads} threads");
-            pool.install(|| check_sets(&scene, &d, &p, &rays, rays.len(), &what));
-            pool.install(|| check_sets(&scene, &d, &p, &rays[..60], 1, &what));
+            pool.install(|| check_sets(&scene, &Lanes(&d, Backend::detect()), &p, &rays, rays.len(), &what));
+            pool.install(|| check_sets(&scene, &Lanes(&d, Backend::detect()), &p, &rays[..60], 1, &what));
         }
     }
 }
@@ -141,7 +153,14 @@ fn every_split_rule_and_leaf_threshold_gives_the_same_hits() {
     for split in SplitRule::ALL {
         for (leaf_rays, leaf_tris) in [(1, 1), (8, 8), (64, 2), (2, 64), (DacrtParams::MAX_LEAF, 1)] {
             let p = DacrtParams { leaf_rays, leaf_tris, split };
-            check_sets(&scene, &d, &p, &rays, 1024, &format!("{split:?} {leaf_rays}/{leaf_tris}"));
+            check_sets(
+                &scene,
+                &Lanes(&d, Backend::detect()),
+                &p,
+                &rays,
+                1024,
+                &format!("{split:?} {leaf_rays}/{leaf_tris}"),
+            );
         }
     }
 }
@@ -151,16 +170,14 @@ fn every_split_rule_and_leaf_threshold_gives_the_same_hits() {
 #[test]
 fn camera_and_surface_rays_through_the_tracer_equal_mono() {
     let scene = builtin::build("kitchen", Detail::Test).unwrap();
-    let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let d = Dacrt::new(&scene);
+    let structures = common::structures(&scene, &[Method::Mono, Method::Dacrt]);
     let cam = scene.default_view().unwrap().camera;
     let (w, h) = (64, 48);
     let raster = cam.raster(w, h);
     let rays: Vec<Option<Ray>> =
         (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| Some(raster.primary(x, y))).collect();
-    let mono = Tracer::new(&kd, None, TraceOptions::default());
-    let dacrt =
-        Tracer::new(&kd, None, TraceOptions { method: Method::Dacrt, ..TraceOptions::default() }).with_dacrt(&d);
+    let mono = Tracer::new(&structures, TraceOptions::default()).unwrap();
+    let dacrt = Tracer::new(&structures, TraceOptions { method: Method::Dacrt, ..TraceOptions::default() }).unwrap();
     let mut s = TraversalStats::default();
     let mut want = vec![None; rays.len()];
     let mut got = vec![None; rays.len()];
@@ -199,7 +216,7 @@ fn degenerate_scenes_and_extreme_coordinates() {
     let empty = Dacrt::new(&SceneBuilder::new().build());
     let rays = [Some(Ray::new(Vec3::ZERO, Vec3::X)), None, Some(Ray::new(Vec3::ONE, Vec3::ZERO))];
     let mut hits = [Some(Hit { t: 1.0, tri: 0, u: 0.0, v: 0.0 }); 3];
-    empty.intersect(&DacrtParams::default(), &rays, &mut hits, &mut s);
+    empty.intersect(&DacrtParams::default(), Backend::detect(), &rays, &mut hits, &mut s);
     assert_eq!(hits, [None; 3], "results are reset, invalid rays skipped");
 
     let mut b = SceneBuilder::new();
@@ -214,12 +231,12 @@ fn degenerate_scenes_and_extreme_coordinates() {
         Some(Ray::new(Vec3::new(-1.0, 0.0, 0.0), Vec3::X)),
     ];
     let mut hits = [None; 3];
-    d.intersect(&DacrtParams::default(), &rays, &mut hits, &mut s);
+    d.intersect(&DacrtParams::default(), Backend::detect(), &rays, &mut hits, &mut s);
     assert_eq!(hits[0].map(|h| (h.tri, h.t)), Some((0, 1.0)));
     assert_eq!(hits[1], None);
     check_hits(
         &one,
-        &d,
+        &Lanes(&d, Backend::detect()),
         &[Ray::new(Vec3::new(-1.0, 0.0, 0.0), Vec3::X), Ray::new(Vec3::new(0.5, -1.0, 0.0), Vec3::Y)],
         "one",
     );
@@ -228,7 +245,7 @@ fn degenerate_scenes_and_extreme_coordinates() {
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
         let d = Dacrt::new(&scene);
         let p = DacrtParams::default();
-        check_sets(&scene, &d, &p, &adversarial_rays(&scene, &kd, 100, 9), 512, &name);
+        check_sets(&scene, &Lanes(&d, Backend::detect()), &p, &adversarial_rays(&scene, &kd, 100, 9), 512, &name);
     }
 
     // Triangles spaced ever wider along a line: SAH cuts off one at a time, as deep as it can.
@@ -246,7 +263,7 @@ fn degenerate_scenes_and_extreme_coordinates() {
     rays.extend((0..50).map(|k| Ray::new(Vec3::new(2e15, 0.25, 0.25), Vec3::new(-1.0, 1e-4 * k as f32, 0.0))));
     let d = Dacrt::new(&deep);
     let p = DacrtParams { leaf_rays: 1, leaf_tris: 1, split: SplitRule::Sah };
-    check_sets(&deep, &d, &p, &rays, rays.len(), "deep");
+    check_sets(&deep, &Lanes(&d, Backend::detect()), &p, &rays, rays.len(), "deep");
 }
 
 /// The camera inside geometry: origins inside walls and pillars, every axis direction and diagonals, as one set.
@@ -267,5 +284,5 @@ fn camera_inside_geometry() {
         Vec3::new(-0.0, 1.0, 0.0),
     ];
     let rays: Vec<Ray> = inside.iter().flat_map(|&o| dirs.iter().map(move |&d| Ray::new(o, d))).collect();
-    check_sets(&scene, &d, &p, &rays, rays.len(), "inside geometry");
+    check_sets(&scene, &Lanes(&d, Backend::detect()), &p, &rays, rays.len(), "inside geometry");
 }

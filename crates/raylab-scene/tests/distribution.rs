@@ -1,11 +1,10 @@
 //! The distribution ray tracer (MBVH RS paper's workload): the same image with every method, progressive
 //! passes that add new samples, and depth of field that blurs only what is out of focus.
 
+mod common;
+
 use glam::Vec3;
-use raylab_core::dacrt::Dacrt;
 use raylab_core::distribution::{Accumulator, DistributionSettings, render_pass};
-use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::builtin::{self, Detail};
@@ -17,16 +16,13 @@ fn settings() -> DistributionSettings {
 #[test]
 fn every_method_traces_the_same_paths() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let mbvh = Mbvh::build(&scene);
-    let dacrt = Dacrt::new(&scene);
+    let methods = [Method::Mono, Method::Packet, Method::Mft, Method::Mbvh, Method::MbvhRs, Method::Dacrt];
+    let structures = common::structures(&scene, &methods);
     let cam = scene.default_view().unwrap().camera;
     let light = scene.lights[0];
     let s = settings();
     let image = |method| {
-        let tracer = Tracer::new(&tree, None, TraceOptions { method, ..TraceOptions::default() })
-            .with_mbvh(&mbvh)
-            .with_dacrt(&dacrt);
+        let tracer = Tracer::new(&structures, TraceOptions { method, ..TraceOptions::default() }).unwrap();
         let mut acc = Accumulator::new(s.width, s.height);
         let stats = render_pass(&scene, &tracer, &cam, light, &s, 0, &mut acc);
         assert_eq!(stats.len(), 3, "camera rays and two bounces");
@@ -46,8 +42,8 @@ fn every_method_traces_the_same_paths() {
 #[test]
 fn passes_accumulate_new_samples() {
     let scene = builtin::build("arena", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let structures = common::structures(&scene, &[Method::Mono]);
+    let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
     let cam = scene.default_view().unwrap().camera;
     let s = settings();
     let mut one = Accumulator::new(s.width, s.height);
@@ -64,8 +60,8 @@ fn passes_accumulate_new_samples() {
 #[test]
 fn depth_of_field_keeps_the_focus_plane_sharp() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let structures = common::structures(&scene, &[Method::Mono]);
+    let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
     let mut cam = scene.default_view().unwrap().camera;
     let pin = cam.raster(9, 9).lens_ray(4.5, 4.5, glam::Vec2::ZERO);
     cam.aperture = 0.3;

@@ -1,15 +1,17 @@
-//! Moving geometry: the animation moves its objects rigidly; after a move, a refitted MBVH, a rebuilt kd-tree
-//! and DACRT (set up again from the moved triangles) all equal brute force on the moved scene; bad moves are refused.
+//! Moving geometry: the animation moves its objects rigidly; after a move, `Structures::update` refits the MBVH,
+//! rebuilds the kd-tree and sets DACRT up again, and all equal brute force on the moved scene; bad moves are
+//! refused.
 
 mod common;
 
 use common::{adversarial_rays, check_hits};
 use glam::Vec3;
-use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::mbvh::{Mbvh, MbvhParams};
+use raylab_core::method::{Method, Purpose, Structure};
 use raylab_core::ray::Ray;
 use raylab_core::scene::SceneBuilder;
+use raylab_core::structures::{StructureParams, Structures};
+use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::animation::Animation;
 use raylab_scene::builtin::{self, Detail};
 
@@ -20,28 +22,35 @@ fn every_structure_follows_the_motion() {
     assert!(anim.moving_triangles() > 100);
     assert_eq!(scene.triangle_count(), base.triangle_count() + anim.moving_triangles());
     let rest = scene.positions.clone();
-    let mut mbvh = Mbvh::build(&scene);
+    let methods = [Method::Mono, Method::Mbvh, Method::Dacrt];
+    let mut structures = Structures::build(&scene, &methods, Purpose::Rays, &StructureParams::default()).unwrap();
     // Spatial splits everywhere: leaves hold clipped parts of triangles, which a refit grows to whole ones.
-    let mut spatial = Mbvh::build_with(&scene, &MbvhParams { spatial_min_refs: 0, ..MbvhParams::default() });
+    let spatial_params =
+        StructureParams { mbvh: MbvhParams { spatial_min_refs: 0, ..MbvhParams::default() }, ..Default::default() };
+    let mut spatial = Structures::build(&scene, &[Method::Mbvh], Purpose::Rays, &spatial_params).unwrap();
     let first_moving = base.positions.len();
     for (k, t) in [0.3f32, 1.1, 2.9].into_iter().enumerate() {
         anim.apply(&mut scene, t).unwrap();
         assert_eq!(scene.positions[..first_moving], rest[..first_moving], "the base scene stays put");
         assert!(scene.positions[first_moving..] != rest[first_moving..], "t = {t}: the objects moved");
-        let refit = mbvh.refit(&scene).unwrap();
+        let times = structures.update(&scene).unwrap();
+        let updated: Vec<Structure> = times.iter().map(|&(s, _)| s).collect();
+        assert_eq!(updated, [Structure::ThesisKd, Structure::Mbvh, Structure::Dacrt]);
+        let refit = times[1].1;
         assert!(refit.as_secs_f64() < 1.0);
-        spatial.refit(&scene).unwrap();
-        let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-        let dacrt = Dacrt::new(&scene);
+        spatial.update(&scene).unwrap();
+        let tracer = |s, method| Tracer::for_rays(s, TraceOptions { method, ..TraceOptions::default() }).unwrap();
+        let kd = structures.kd(Structure::ThesisKd).unwrap();
         // Rays aimed at the moving objects' vertices and random rays.
-        let mut rays = adversarial_rays(&scene, &kd, 150, 40 + k as u32);
+        let mut rays = adversarial_rays(&scene, kd, 150, 40 + k as u32);
         let eye = scene.default_view().unwrap().camera.eye;
         rays.extend(scene.positions[first_moving..].iter().step_by(7).map(|&p| Ray::new(eye, p - eye)));
         let what = format!("t = {t}");
-        check_hits(&scene, &mbvh, &rays, &format!("refitted MBVH, {what}"));
-        check_hits(&scene, &spatial, &rays, &format!("refitted MBVH with spatial splits, {what}"));
-        check_hits(&scene, &kd, &rays, &format!("rebuilt kd-tree, {what}"));
-        check_hits(&scene, &dacrt, &rays[..400], &format!("DACRT, {what}"));
+        check_hits(&scene, &tracer(&structures, Method::Mbvh), &rays, &format!("refitted MBVH, {what}"));
+        let spatial_mbvh = tracer(&spatial, Method::Mbvh);
+        check_hits(&scene, &spatial_mbvh, &rays, &format!("refitted MBVH with spatial splits, {what}"));
+        check_hits(&scene, &tracer(&structures, Method::Mono), &rays, &format!("rebuilt kd-tree, {what}"));
+        check_hits(&scene, &tracer(&structures, Method::Dacrt), &rays[..400], &format!("DACRT, {what}"));
     }
     // The pose depends on the time only: back at t = 0 the rest pose returns (up to rounding).
     anim.apply(&mut scene, 0.0).unwrap();

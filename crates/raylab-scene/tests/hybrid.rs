@@ -2,10 +2,9 @@
 //! reproduce the Whitted renderer's first reflections, for every method and shadow technique; on a perfect
 //! mirror they are exactly the Whitted frame's pixels.
 
+mod common;
+
 use glam::Vec3;
-use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::mbvh::Mbvh;
 use raylab_core::method::Method;
 use raylab_core::render::hybrid::{cpu_gbuffer, psnr, reference_reflections, reflection_ray, shade_reflections};
 use raylab_core::render::shade::to_display;
@@ -19,12 +18,11 @@ use raylab_scene::builtin::{self, Detail};
 #[test]
 fn gbuffer_reflections_match_the_whitted_renderer() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let mbvh = Mbvh::build(&scene);
-    let dacrt = Dacrt::new(&scene);
+    let methods = [Method::Mono, Method::Mft, Method::Mbvh, Method::Dacrt];
+    let structures = common::structures(&scene, &methods);
     let cam = scene.default_view().unwrap().camera;
     let light = scene.lights[0];
-    let mono = Tracer::new(&tree, None, TraceOptions::default());
+    let mono = Tracer::new(&structures, TraceOptions::default()).unwrap();
     for shadows in [Shadows::Hard, Shadows::None, Shadows::Cached] {
         let settings = RenderSettings { width: 96, height: 72, shadows, ..RenderSettings::default() };
         let want = reference_reflections(&scene, &mono, &cam, light, &settings);
@@ -34,10 +32,8 @@ fn gbuffer_reflections_match_the_whitted_renderer() {
         let eps = surface_epsilon(&scene);
         let rays: Vec<_> = g.iter().map(|p| reflection_ray(cam.eye, p, eps)).collect();
         assert_eq!(rays.iter().filter(|r| r.is_some()).count(), reflective, "the same pixels are reflective");
-        for method in [Method::Mono, Method::Mft, Method::Mbvh, Method::Dacrt] {
-            let tracer = Tracer::new(&tree, None, TraceOptions { method, ..TraceOptions::default() })
-                .with_mbvh(&mbvh)
-                .with_dacrt(&dacrt);
+        for method in methods {
+            let tracer = Tracer::new(&structures, TraceOptions { method, ..TraceOptions::default() }).unwrap();
             let (got, stats, _) = shade_reflections(&scene, &tracer, &cam, light, &settings, &rays);
             assert!(stats.rays >= reflective as u64);
             let pairs = got.iter().zip(&want).filter_map(|(g, w)| w.map(|w| (*g, w)));
@@ -59,8 +55,8 @@ fn on_a_perfect_mirror_the_reflection_is_the_whitted_pixel() {
     m.cuboid(Vec3::new(-3.0, -0.9, -2.2), Vec3::new(3.0, 2.5, -2.0));
     m.scene_mut().lights.push(PointLight::at(Vec3::new(0.0, 3.0, 3.0)));
     let scene = m.build();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let structures = common::structures(&scene, &[Method::Mono]);
+    let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
     let cam = Camera {
         eye: Vec3::new(0.5, 0.8, 4.5),
         target: Vec3::new(0.0, 0.5, -2.0),

@@ -2,8 +2,9 @@
 //! mirror shows what it should where it should, clear glass of index 1 changes nothing, Beer's law darkens
 //! with thickness, and light inside glass past the critical angle reflects.
 
+mod common;
+
 use glam::Vec3;
-use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::method::Method;
 use raylab_core::render::{Frame, RenderSettings, render};
 use raylab_core::scene::{Camera, Material, MaterialKind, PointLight, Scene};
@@ -12,8 +13,8 @@ use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::mesh::MeshBuilder;
 
 fn draw(scene: &Scene, cam: &Camera, size: (u32, u32), method: Method) -> Frame {
-    let tree = KdTree::build(scene, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() });
+    let structures = common::structures(scene, &[method]);
+    let tracer = Tracer::new(&structures, TraceOptions { method, ..Default::default() }).unwrap();
     let settings =
         RenderSettings { width: size.0, height: size.1, tile: 8, shadows: Shadows::None, ..Default::default() };
     render(scene, &tracer, cam, scene.lights[0], &settings)
@@ -69,8 +70,8 @@ fn a_mirror_shows_the_reflection_at_the_predicted_pixel() {
         assert!(r < 10 && g < 10 && b < 10, "{method}: the mirror off the box is ({r}, {g}, {b})");
     }
     // With no bounces allowed the mirror is its own dim base colour, and the image is gone.
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let structures = common::structures(&scene, &[Method::Mono]);
+    let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
     let s =
         RenderSettings { width: size.0, height: size.1, shadows: Shadows::None, max_depth: 0, ..Default::default() };
     let f = render(&scene, &tracer, &cam, scene.lights[0], &s);

@@ -4,14 +4,16 @@
 
 mod common;
 
-use common::{adversarial_rays, check_hits, incoherent, scaled_scenes};
+use common::{Lanes, adversarial_rays, check_hits, incoherent, scaled_scenes};
 use glam::Vec3;
 use raylab_core::kdtree::{KdParams, KdTree};
 use raylab_core::mbvh::{EMPTY, Mbvh, MbvhParams};
+use raylab_core::method::{Method, Purpose};
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
 use raylab_core::scene::{SceneBuilder, Triangle};
 use raylab_core::stats::TraversalStats;
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_scene::builtin::{self, Detail};
 use raylab_scene::mesh::Jitter;
 use raylab_simd::Backend;
@@ -31,12 +33,11 @@ fn mbvh_matches_brute_force_on_every_builtin_scene_and_backend() {
     for name in builtin::names() {
         let scene = builtin::build(name, Detail::Test).unwrap();
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-        for (tree, mut m) in trees(&scene) {
+        for (tree, m) in trees(&scene) {
             for backend in Backend::available() {
-                m.backend = backend;
                 let what = format!("{name} {tree} {}", backend.name());
-                check_hits(&scene, &m, &adversarial_rays(&scene, &kd, 200, 3), &what);
-                check_hits(&scene, &m, &incoherent(&scene, 3000, 11), &what);
+                check_hits(&scene, &Lanes(&m, backend), &adversarial_rays(&scene, &kd, 200, 3), &what);
+                check_hits(&scene, &Lanes(&m, backend), &incoherent(&scene, 3000, 11), &what);
             }
         }
     }
@@ -67,12 +68,12 @@ fn rays_leaving_surfaces_behave_like_mono() {
         }
     }
     assert!(offset.len() > 500);
-    check_hits(&scene, &m, &offset, "MBVH");
+    check_hits(&scene, &Lanes(&m, Backend::detect()), &offset, "MBVH");
     check_hits(&scene, &kd, &offset, "mono");
     let self_hit = |h: Option<raylab_core::ray::Hit>| h.is_some_and(|h| h.t < eps);
     let mut compared = 0;
     for r in &exact {
-        let (a, b) = (kd.intersect(r, &mut s), m.intersect(r, &mut s));
+        let (a, b) = (kd.intersect(r, &mut s), m.intersect(r, Backend::detect(), &mut s));
         if self_hit(a) || self_hit(b) {
             continue;
         }
@@ -92,7 +93,7 @@ fn empty_scene_single_triangle_and_extreme_coordinates() {
     let empty = SceneBuilder::new().build();
     let m = Mbvh::build(&empty);
     let mut s = TraversalStats::default();
-    assert_eq!(m.intersect(&Ray::new(Vec3::ZERO, Vec3::X), &mut s), None);
+    assert_eq!(m.intersect(&Ray::new(Vec3::ZERO, Vec3::X), Backend::detect(), &mut s), None);
     assert!(m.nodes()[0].child.iter().all(|&c| c == EMPTY));
 
     let mut b = SceneBuilder::new();
@@ -100,12 +101,12 @@ fn empty_scene_single_triangle_and_extreme_coordinates() {
     b.triangles = vec![Triangle { v: [0, 1, 2], material: 0 }];
     let one = b.build();
     let m = Mbvh::build(&one);
-    let hit = m.intersect(&Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::NEG_Z), &mut s).unwrap();
+    let hit = m.intersect(&Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::NEG_Z), Backend::detect(), &mut s).unwrap();
     assert_eq!((hit.tri, hit.t), (0, 1.0));
     // A ray in the triangle's plane, along an axis (zero direction components).
     check_hits(
         &one,
-        &m,
+        &Lanes(&m, Backend::detect()),
         &[Ray::new(Vec3::new(-1.0, 0.0, 0.0), Vec3::X), Ray::new(Vec3::new(0.5, -1.0, 0.0), Vec3::Y)],
         "one",
     );
@@ -113,7 +114,12 @@ fn empty_scene_single_triangle_and_extreme_coordinates() {
     for (name, scene) in scaled_scenes() {
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
         for (tree, m) in trees(&scene) {
-            check_hits(&scene, &m, &adversarial_rays(&scene, &kd, 100, 9), &format!("{name} {tree}"));
+            check_hits(
+                &scene,
+                &Lanes(&m, Backend::detect()),
+                &adversarial_rays(&scene, &kd, 100, 9),
+                &format!("{name} {tree}"),
+            );
         }
     }
 }
@@ -164,7 +170,11 @@ fn every_triangle_is_covered_by_its_leaves_and_lanes_are_well_formed() {
         let bf = BruteForce::new(&scene);
         let mut s = TraversalStats::default();
         for r in incoherent(&scene, 300, 2) {
-            assert_eq!(m.intersect(&r, &mut s).map(|h| h.t), bf.intersect(&r, &mut s).map(|h| h.t), "{tree}: {r:?}");
+            assert_eq!(
+                m.intersect(&r, Backend::detect(), &mut s).map(|h| h.t),
+                bf.intersect(&r, &mut s).map(|h| h.t),
+                "{tree}: {r:?}"
+            );
         }
     }
 }
@@ -175,12 +185,14 @@ fn every_triangle_is_covered_by_its_leaves_and_lanes_are_well_formed() {
 #[test]
 fn ray_streams_match_brute_force() {
     use raylab_core::mbvh::StreamLeaves;
-    use raylab_core::method::Method;
     use raylab_core::trace::{TraceOptions, Tracer};
     for name in ["atrium", "forest"] {
         let scene = builtin::build(name, Detail::Test).unwrap();
         let kd = KdTree::build(&scene, &KdParams::default()).unwrap();
-        let m = Mbvh::build(&scene);
+        let params = StructureParams::default();
+        let default = Structures::build(&scene, &[Method::MbvhRs], Purpose::Rays, &params).unwrap();
+        let spatial_params = StructureParams { mbvh: spatial_everywhere(), ..params };
+        let spatial = Structures::build(&scene, &[Method::MbvhRs], Purpose::Rays, &spatial_params).unwrap();
         let bf = BruteForce::new(&scene);
         // Incoherent rays, then the adversarial set: zero direction components of both signs, rays in split
         // planes and along triangle planes, through vertices and edges, short segments.
@@ -202,18 +214,16 @@ fn ray_streams_match_brute_force() {
             [(16, true), (256, true), (256, false), (4095, true)].into_iter().map(move |(g, o)| (b, g, o))
         });
         let cases = cases.flat_map(|c| StreamLeaves::ALL.map(|l| (c, l)));
-        let spatial = Mbvh::build_with(&scene, &spatial_everywhere());
-        let cases = cases.flat_map(|c| [("default", &m, c), ("spatial", &spatial, c)]);
-        for (tree, m, ((backend, group, ordered), leaves)) in cases {
+        let cases = cases.flat_map(|c| [("default", &default, c), ("spatial", &spatial, c)]);
+        for (tree, structures, ((backend, group, ordered), leaves)) in cases {
             let opts = TraceOptions {
                 method: Method::MbvhRs,
+                backend,
                 stream_order: ordered,
                 stream_leaves: leaves,
                 ..TraceOptions::default()
             };
-            let mut m = m.clone();
-            m.backend = backend;
-            let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
+            let tracer = Tracer::for_rays(structures, opts).unwrap();
             let mut s = TraversalStats::default();
             for chunk in rays.chunks(group) {
                 let mut hits = vec![None; chunk.len()];
@@ -233,7 +243,7 @@ fn ray_streams_match_brute_force() {
         let mut fetches = Vec::new();
         for group in [16, 32, 512] {
             let opts = TraceOptions { method: Method::MbvhRs, stream_group: Some(group), ..TraceOptions::default() };
-            let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
+            let tracer = Tracer::for_rays(&default, opts).unwrap();
             let mut s = TraversalStats::default();
             let mut hits = vec![None; tile.len()];
             let mut blocked = vec![false; tile.len()];
@@ -253,7 +263,6 @@ fn ray_streams_match_brute_force() {
 #[test]
 fn ray_streams_on_degenerate_scenes() {
     use raylab_core::mbvh::StreamLeaves;
-    use raylab_core::method::Method;
     use raylab_core::trace::{TraceOptions, Tracer};
     let mut b = SceneBuilder::new();
     b.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
@@ -269,12 +278,13 @@ fn ray_streams_on_degenerate_scenes() {
             rays.extend(adversarial_rays(&scene, &kd, 60, 13));
         }
         let rays: Vec<Option<Ray>> = rays.into_iter().map(Some).collect();
-        let mut m = Mbvh::build(&scene);
+        let structures = Structures::build(&scene, &[Method::MbvhRs], Purpose::Rays, &StructureParams::default());
+        let structures = structures.unwrap();
         for backend in Backend::available() {
-            m.backend = backend;
             for leaves in StreamLeaves::ALL {
-                let opts = TraceOptions { method: Method::MbvhRs, stream_leaves: leaves, ..TraceOptions::default() };
-                let tracer = Tracer::new(&kd, None, opts).with_mbvh(&m);
+                let opts =
+                    TraceOptions { method: Method::MbvhRs, backend, stream_leaves: leaves, ..TraceOptions::default() };
+                let tracer = Tracer::for_rays(&structures, opts).unwrap();
                 let mut s = TraversalStats::default();
                 let mut hits = vec![None; rays.len()];
                 let mut blocked = vec![false; rays.len()];
@@ -310,5 +320,5 @@ fn a_pathologically_deep_tree_still_traces_right() {
     let mut rays = adversarial_rays(&scene, &kd, 100, 4);
     rays.extend((0..200).map(|k| Ray::new(Vec3::new(-1.0, 0.2 + k as f32 * 1e-3, 0.3), Vec3::new(1.0, 0.0, 0.0))));
     rays.extend((0..50).map(|k| Ray::new(Vec3::new(2e15, 0.25, 0.25), Vec3::new(-1.0, 1e-4 * k as f32, 0.0))));
-    check_hits(&scene, &m, &rays, "deep");
+    check_hits(&scene, &Lanes(&m, Backend::detect()), &rays, "deep");
 }

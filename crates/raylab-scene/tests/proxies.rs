@@ -6,13 +6,14 @@
 
 use glam::Vec3;
 use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::method::Method;
+use raylab_core::method::{Method, Purpose, Structure};
 use raylab_core::packet::{Cone, Disc, Frustum};
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
 use raylab_core::scene::Scene;
 use raylab_core::shadow::LightSamples;
 use raylab_core::stats::TraversalStats;
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::trace::{Proxy, TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 use raylab_scene::builtin::{self, Detail};
@@ -52,7 +53,13 @@ fn surface_points(scene: &Scene, tree: &KdTree, n: u32) -> Vec<Vec3> {
 }
 
 /// Checks both proxies of `disc` seen from `apex` on `targets` against brute force.
-fn check(tree: &KdTree, bf: &BruteForce, apex: Vec3, disc: &Disc, targets: &[Vec3], what: &str) {
+/// The packet method's structures, on the thesis's kd-tree.
+fn packets_on_thesis_tree(scene: &Scene) -> Structures {
+    let params = StructureParams { packet_kd: KdParams::default(), ..StructureParams::default() };
+    Structures::build(scene, &[Method::Packet], Purpose::Frames, &params).unwrap()
+}
+
+fn check(structures: &Structures, bf: &BruteForce, apex: Vec3, disc: &Disc, targets: &[Vec3], what: &str) {
     let rays: Vec<Option<Ray>> = targets
         .iter()
         .map(|&p| {
@@ -69,7 +76,7 @@ fn check(tree: &KdTree, bf: &BruteForce, apex: Vec3, disc: &Disc, targets: &[Vec
         for backend in Backend::available() {
             for cull in [true, false] {
                 let opts = TraceOptions { method: Method::Packet, cull, backend, ..TraceOptions::default() };
-                let tracer = Tracer::new(tree, None, opts);
+                let tracer = Tracer::new(structures, opts).unwrap();
                 let mut got = vec![false; rays.len()];
                 let size = (4, rays.len() / 4);
                 tracer.occluded_in_proxy(proxy, &rays, size, &mut got, &mut stats);
@@ -82,7 +89,7 @@ fn check(tree: &KdTree, bf: &BruteForce, apex: Vec3, disc: &Disc, targets: &[Vec
 /// Checks the proxies of each light seen from each of `points`, lifted off it a little as a shadow ray's
 /// origin is, on the light's stratified samples and on random points of its disc.
 fn check_scene(scene: &Scene, points: &[Vec3], lights: &[(Vec3, f32)], what: &str) {
-    let tree = KdTree::build(scene, &KdParams::default()).unwrap();
+    let structures = packets_on_thesis_tree(scene);
     let bf = BruteForce::new(scene);
     let mut rng = Rng(0x5eed);
     let mut samples = LightSamples::default();
@@ -92,7 +99,7 @@ fn check_scene(scene: &Scene, points: &[Vec3], lights: &[(Vec3, f32)], what: &st
         for &(center, radius) in lights {
             samples.generate(center, radius, p, 16, i as u32);
             let disc = samples.disc;
-            check(&tree, &bf, apex, &disc, &samples.points, what);
+            check(&structures, &bf, apex, &disc, &samples.points, what);
             let (u, v) = disc.normal.any_orthonormal_pair();
             let on_disc: Vec<Vec3> = (0..32)
                 .map(|_| {
@@ -100,7 +107,7 @@ fn check_scene(scene: &Scene, points: &[Vec3], lights: &[(Vec3, f32)], what: &st
                     center + (u * a + v * b) * radius
                 })
                 .collect();
-            check(&tree, &bf, apex, &disc, &on_disc, what);
+            check(&structures, &bf, apex, &disc, &on_disc, what);
         }
     }
 }
@@ -120,7 +127,8 @@ fn proxies_match_brute_force_on_every_builtin_scene() {
 #[test]
 fn proxies_hold_next_to_the_light_and_far_from_the_origin() {
     let scene = builtin::build("arena", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let structures = packets_on_thesis_tree(&scene);
+    let tree = structures.kd(Structure::ThesisKd).unwrap();
     let bf = BruteForce::new(&scene);
     let center = scene.lights[0].position;
     // Right in front of the light the proxies open to their widest, and then there are none.
@@ -128,7 +136,7 @@ fn proxies_hold_next_to_the_light_and_far_from_the_origin() {
     let (u, _) = disc.normal.any_orthonormal_pair();
     let targets: Vec<Vec3> = (0..16).map(|k| center + u * ((k as f32 - 7.5) / 7.5)).collect();
     for gap in [2.0f32, 0.5, 0.34, 0.1, 1e-4] {
-        check(&tree, &bf, center - disc.normal * gap, &disc, &targets, &format!("gap {gap}"));
+        check(&structures, &bf, center - disc.normal * gap, &disc, &targets, &format!("gap {gap}"));
     }
     assert!(Cone::around_disc(center - disc.normal * 0.1, &disc).is_none(), "too wide");
     assert!(Cone::around_disc(center, &disc).is_none(), "an apex on the disc has no proxy");
@@ -136,7 +144,7 @@ fn proxies_hold_next_to_the_light_and_far_from_the_origin() {
     assert!(Cone::around_disc(Vec3::ZERO, &Disc { center: Vec3::NAN, ..disc }).is_none());
     // A scene shifted far from the origin: coordinates carry large absolute rounding errors.
     let shift = Vec3::new(1.0e5, -2.0e5, 3.0e5);
-    let apexes: Vec<Vec3> = surface_points(&scene, &tree, 10).into_iter().map(|p| p + shift).collect();
+    let apexes: Vec<Vec3> = surface_points(&scene, tree, 10).into_iter().map(|p| p + shift).collect();
     let mut far = scene.clone();
     let moved: Vec<Vec3> = far.positions.iter().map(|&p| p + shift).collect();
     far.set_vertices(0, &moved, None).unwrap();

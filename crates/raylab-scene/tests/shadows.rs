@@ -2,11 +2,11 @@
 //! pixels with every traversal method, the kd-tree's edge-width rays agree with brute force, and each
 //! technique meets a case with a known answer.
 
+mod common;
+
 use glam::Vec3;
-use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::mbvh::Mbvh;
-use raylab_core::method::Method;
+use raylab_core::kdtree::KdParams;
+use raylab_core::method::{Method, Purpose, Structure};
 use raylab_core::packet::MAX_LANES;
 use raylab_core::ray::Ray;
 use raylab_core::reference::BruteForce;
@@ -15,6 +15,7 @@ use raylab_core::render::{RenderSettings, ShadowScratch, ShadowTracer, render, s
 use raylab_core::scene::{Camera, Material, PointLight, Scene};
 use raylab_core::shadow::{EdgeWidth, SampleBound, Shadows};
 use raylab_core::stats::TraversalStats;
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::builtin::{self, Detail};
 use raylab_scene::mesh::{Jitter, MeshBuilder};
@@ -51,14 +52,11 @@ fn frame(scene: &Scene, tracer: &Tracer, cam: &Camera, light: PointLight, shadow
 fn every_technique_gives_the_same_pixels_with_every_method() {
     for name in ["atrium", "arena"] {
         let scene = builtin::build(name, Detail::Test).unwrap();
-        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-        let bf = BruteForce::new(&scene);
-        let mbvh = Mbvh::build(&scene);
-        let dacrt = Dacrt::new(&scene);
+        let structures = on_thesis_tree(&scene);
         let cam = scene.default_view().unwrap().camera;
         let light = scene.lights[0];
         for shadows in techniques(&light) {
-            let mono = Tracer::new(&tree, None, TraceOptions::default());
+            let mono = Tracer::new(&structures, TraceOptions::default()).unwrap();
             let want = frame(&scene, &mono, &cam, light, shadows, 8);
             let lit = want.iter().filter(|p| p[0] > 40).count();
             assert!(lit > want.len() / 4, "{name} {shadows}: the frame is mostly dark ({lit} lit pixels)");
@@ -70,9 +68,7 @@ fn every_technique_gives_the_same_pixels_with_every_method() {
             let ties = |method| if matches!(method, Method::Dacrt | Method::Mbvh) { 2 } else { 0 };
             for method in COHERENT {
                 for tile in [4, 16] {
-                    let tracer = Tracer::new(&tree, None, TraceOptions { method, ..Default::default() })
-                        .with_mbvh(&mbvh)
-                        .with_dacrt(&dacrt);
+                    let tracer = Tracer::new(&structures, TraceOptions { method, ..Default::default() }).unwrap();
                     let got = frame(&scene, &tracer, &cam, light, shadows, tile);
                     let diff = got.iter().zip(&want).filter(|(a, b)| a != b).count();
                     assert!(
@@ -83,13 +79,13 @@ fn every_technique_gives_the_same_pixels_with_every_method() {
             }
             if !matches!(shadows, Shadows::MultiSample { samples: 16, .. }) {
                 let reference =
-                    Tracer::new(&tree, Some(&bf), TraceOptions { method: Method::Reference, ..Default::default() });
+                    Tracer::new(&structures, TraceOptions { method: Method::Reference, ..Default::default() }).unwrap();
                 let got = frame(&scene, &reference, &cam, light, shadows, 8);
                 let diff = got.iter().zip(&want).filter(|(a, b)| a != b).count();
                 assert!(diff <= 2, "{name}, {shadows}: {diff} pixels differ from the brute-force reference");
                 // DACRT breaks ties as brute force does, so it gives the reference's pixels exactly.
-                let tracer = Tracer::new(&tree, None, TraceOptions { method: Method::Dacrt, ..Default::default() })
-                    .with_dacrt(&dacrt);
+                let tracer =
+                    Tracer::new(&structures, TraceOptions { method: Method::Dacrt, ..Default::default() }).unwrap();
                 let dacrt_frame = frame(&scene, &tracer, &cam, light, shadows, 8);
                 let diff = dacrt_frame.iter().zip(&got).filter(|(a, b)| a != b).count();
                 assert_eq!(diff, 0, "{name}, {shadows}: {diff} DACRT pixels differ from the brute-force reference");
@@ -103,8 +99,8 @@ fn every_technique_gives_the_same_pixels_with_every_method() {
 #[test]
 fn the_shadow_cache_changes_speed_not_pixels() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let structures = common::structures(&scene, &[Method::Mono]);
+    let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
     let cam = scene.default_view().unwrap().camera;
     let light = scene.lights[0];
     let settings = |shadows| RenderSettings { width: 64, height: 48, shadows, max_depth: 0, ..Default::default() };
@@ -134,7 +130,8 @@ fn the_shadow_cache_changes_speed_not_pixels() {
 fn kd_edge_widths_match_brute_force() {
     for name in ["atrium", "arena", "kitchen", "forest"] {
         let scene = builtin::build(name, Detail::Test).unwrap();
-        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let structures = on_thesis_tree(&scene);
+        let tree = structures.kd(Structure::ThesisKd).unwrap();
         let bf = BruteForce::new(&scene);
         let b = scene.bounds();
         let mut rng = Jitter::new(7);
@@ -166,7 +163,8 @@ fn kd_edge_widths_match_brute_force() {
 fn packet_edge_widths_equal_single_walks() {
     for name in ["atrium", "arena", "kitchen", "forest"] {
         let scene = builtin::build(name, Detail::Test).unwrap();
-        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let structures = on_thesis_tree(&scene);
+        let tree = structures.kd(Structure::ThesisKd).unwrap();
         let b = scene.bounds();
         let mut rng = Jitter::new(11);
         let mut point =
@@ -194,7 +192,8 @@ fn packet_edge_widths_equal_single_walks() {
             assert!(partial > 10, "{name}: only {partial} penumbra rays; the test says little");
             for backend in Backend::available() {
                 let tracer =
-                    Tracer::new(&tree, None, TraceOptions { method: Method::Packet, backend, ..Default::default() });
+                    Tracer::new(&structures, TraceOptions { method: Method::Packet, backend, ..Default::default() })
+                        .unwrap();
                 let mut states = vec![single.clone(); rays.len()];
                 let mut got = vec![-1.0; rays.len()];
                 tracer.edge_widths(&rays, None, &mut states, &mut got, &mut s);
@@ -215,7 +214,8 @@ fn packet_edge_widths_equal_single_walks() {
 fn bundle_edge_widths_equal_single_walks() {
     for name in ["atrium", "arena", "kitchen", "forest"] {
         let scene = builtin::build(name, Detail::Test).unwrap();
-        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let structures = on_thesis_tree(&scene);
+        let tree = structures.kd(Structure::ThesisKd).unwrap();
         let b = scene.bounds();
         let mut rng = Jitter::new(5);
         let mut point =
@@ -259,7 +259,7 @@ fn bundle_edge_widths_equal_single_walks() {
                 for cull in [true, false] {
                     for backend in Backend::available() {
                         let options = TraceOptions { method, backend, cull, ..Default::default() };
-                        let tracer = Tracer::new(&tree, None, options);
+                        let tracer = Tracer::new(&structures, options).unwrap();
                         let mut s = TraversalStats::default();
                         for ((light, g), want) in groups.iter().zip(&want) {
                             let mut states = vec![single.clone(); g.len().max(MAX_LANES)];
@@ -303,8 +303,9 @@ fn box_over_floor(open_quad: bool) -> Scene {
 }
 
 /// Visibility of the floor point `(x, 0, 0.05)` under `shadows`.
-fn floor_visibility(scene: &Scene, tree: &KdTree, shadows: Shadows, x: f32) -> f32 {
-    let tracer = Tracer::new(tree, None, TraceOptions::default());
+fn floor_visibility(scene: &Scene, structures: &Structures, shadows: Shadows, x: f32) -> f32 {
+    let tracer = Tracer::new(structures, TraceOptions::default()).unwrap();
+    let tree = structures.kd(Structure::ThesisKd).unwrap();
     let st = ShadowTracer { tracer: &tracer, light: scene.lights[0], shadows, epsilon: surface_epsilon(scene) };
     let ray = Ray::new(Vec3::new(x, 1e-3 + 0.4, 0.05), Vec3::NEG_Y);
     let hit = tree.intersect(&ray, &mut TraversalStats::default()).expect("the floor");
@@ -316,7 +317,7 @@ fn floor_visibility(scene: &Scene, tree: &KdTree, shadows: Shadows, x: f32) -> f
 #[test]
 fn a_closed_box_casts_an_umbra_and_a_penumbra_that_widens_with_r() {
     let scene = box_over_floor(false);
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let structures = on_thesis_tree(&scene);
     // The chord of a floor point's shadow segment through the box, by clipping it to the box's slabs; the
     // hard shadow ends near x = 4/3, where the segment just touches the box's top edge.
     let eps = surface_epsilon(&scene);
@@ -344,8 +345,8 @@ fn a_closed_box_casts_an_umbra_and_a_penumbra_that_widens_with_r() {
         let mut penumbra = 0;
         for k in 0..=160 {
             let x = k as f32 / 100.0;
-            let hard = floor_visibility(&scene, &tree, Shadows::Hard, x);
-            let soft = floor_visibility(&scene, &tree, edge, x);
+            let hard = floor_visibility(&scene, &structures, Shadows::Hard, x);
+            let soft = floor_visibility(&scene, &structures, edge, x);
             let predicted = 1.0 - (chord(x) / r).min(1.0);
             assert!((soft - predicted).abs() < 2e-3, "R {r}, x {x}: visibility {soft}, predicted {predicted}");
             if hard == 1.0 {
@@ -365,16 +366,16 @@ fn a_closed_box_casts_an_umbra_and_a_penumbra_that_widens_with_r() {
 #[test]
 fn a_thin_open_quad_falls_back_to_a_hard_shadow() {
     let scene = box_over_floor(true);
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let structures = on_thesis_tree(&scene);
     for k in 0..=40 {
         let x = k as f32 / 20.0;
-        let hard = floor_visibility(&scene, &tree, Shadows::Hard, x);
+        let hard = floor_visibility(&scene, &structures, Shadows::Hard, x);
         for r in [0.2, 5.0] {
-            let soft = floor_visibility(&scene, &tree, Shadows::EdgeWidth { radius: r, leak_fix: false }, x);
+            let soft = floor_visibility(&scene, &structures, Shadows::EdgeWidth { radius: r, leak_fix: false }, x);
             assert_eq!(soft, hard, "x {x}, R {r}");
         }
     }
-    assert_eq!(floor_visibility(&scene, &tree, Shadows::Hard, 0.0), 0.0);
+    assert_eq!(floor_visibility(&scene, &structures, Shadows::Hard, 0.0), 0.0);
 }
 
 /// A sphere light of radius 1 at height 10 over a point, half hidden by a straight edge at height 5: the seen
@@ -397,11 +398,12 @@ fn multi_sampled_visibility_converges_to_the_analytic_fraction() {
         );
         let mut scene = m.build();
         scene.lights.push(PointLight { radius: 1.0, ..PointLight::at(Vec3::new(0.0, 10.0, 0.0)) });
-        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+        let structures = on_thesis_tree(&scene);
+        let tree = structures.kd(Structure::ThesisKd).unwrap();
         // Seen from the origin, the edge falls on the light's disc at x = 2 * edge_x; the disc beyond it shows.
         let d = 2.0 * edge_x as f64;
         let analytic = (d.clamp(-1.0, 1.0).acos() - d * (1.0 - d * d).max(0.0).sqrt()) / std::f64::consts::PI;
-        let tracer = Tracer::new(&tree, None, TraceOptions::default());
+        let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
         let ray = Ray::new(Vec3::new(0.0, 0.5, 0.0), Vec3::NEG_Y);
         let hit = tree.intersect(&ray, &mut TraversalStats::default()).unwrap();
         for (samples, tol) in [(1024, 0.01), (32, 0.06)] {
@@ -432,8 +434,8 @@ fn multi_sampled_visibility_converges_to_the_analytic_fraction() {
 #[test]
 fn packets_shared_by_neighbouring_points_keep_each_points_visibility() {
     let scene = builtin::build("atrium", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let bf = BruteForce::new(&scene);
+    let structures = on_thesis_tree(&scene);
+    let tree = structures.kd(Structure::ThesisKd).unwrap();
     let cam = scene.default_view().unwrap().camera;
     let light = PointLight { radius: scene.lights[0].radius.max(0.5), ..scene.lights[0] };
     let (w, h) = (37u32, 27u32);
@@ -445,7 +447,7 @@ fn packets_shared_by_neighbouring_points_keep_each_points_visibility() {
     assert!(surfaces.iter().any(Option::is_none) && surfaces.iter().any(Option::is_some));
     let seeds: Vec<u32> = (0..w * h).collect();
     let dims = (w as usize, h as usize);
-    let reference = Tracer::new(&tree, Some(&bf), TraceOptions { method: Method::Reference, ..Default::default() });
+    let reference = Tracer::new(&structures, TraceOptions { method: Method::Reference, ..Default::default() }).unwrap();
     for samples in [4, 8, 16] {
         let shadows = Shadows::MultiSample { samples, bound: SampleBound::Packets };
         let visibility = |tracer: &Tracer| {
@@ -456,7 +458,8 @@ fn packets_shared_by_neighbouring_points_keep_each_points_visibility() {
         let penumbra = want.iter().filter(|&&v| v > 0.0 && v < 1.0).count();
         assert!(penumbra > 10, "{samples} samples: only {penumbra} points in penumbra");
         for backend in Backend::available() {
-            let tracer = Tracer::new(&tree, None, TraceOptions { method: Method::Mft, backend, ..Default::default() });
+            let tracer =
+                Tracer::new(&structures, TraceOptions { method: Method::Mft, backend, ..Default::default() }).unwrap();
             let got = visibility(&tracer);
             for (i, (g, v)) in got.iter().zip(&want).enumerate() {
                 assert_eq!(g, v, "{samples} samples, {backend:?}: point {i}");
@@ -470,8 +473,8 @@ fn packets_shared_by_neighbouring_points_keep_each_points_visibility() {
 #[test]
 fn a_point_light_makes_every_technique_hard() {
     let scene = builtin::build("arena", Detail::Test).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions { method: Method::Mft, ..Default::default() });
+    let structures = on_thesis_tree(&scene);
+    let tracer = Tracer::new(&structures, TraceOptions { method: Method::Mft, ..Default::default() }).unwrap();
     let cam = scene.default_view().unwrap().camera;
     let light = PointLight { radius: 0.0, ..scene.lights[0] };
     let hard = frame(&scene, &tracer, &cam, light, Shadows::Hard, 8);
@@ -482,4 +485,11 @@ fn a_point_light_makes_every_technique_hard() {
     ] {
         assert_eq!(frame(&scene, &tracer, &cam, light, shadows, 8), hard, "{shadows}");
     }
+}
+
+/// Every method's structures for frames, with the thesis's kd-tree for every kd-tree method (both slots take
+/// its cost model), and the brute-force reference.
+fn on_thesis_tree(scene: &Scene) -> Structures {
+    let params = StructureParams { packet_kd: KdParams::default(), ..StructureParams::default() };
+    Structures::build(scene, &Method::ALL, Purpose::Frames, &params).unwrap()
 }

@@ -6,10 +6,12 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
+use raylab_core::intersector::Intersector;
 use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::method::Intersector;
+use raylab_core::method::{Method, Purpose};
 use raylab_core::scene::Camera;
 use raylab_core::stats::TraversalStats;
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 
 fn sponza_path() -> Option<PathBuf> {
@@ -68,11 +70,11 @@ fn sponza_render_matches_embree_pixel_for_pixel() {
     };
     let reference = image::open(path.with_file_name("embree_view.png")).expect("embree_view.png").to_luma8();
     let (scene, _) = raylab_scene::obj_positions::load(&path).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
+    let structures = Structures::build(&scene, &[Method::Mono], Purpose::Frames, &StructureParams::default()).unwrap();
     let camera = Camera::look_at(Vec3::new(-12.5, 2.5, 0.0), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 65.0);
     let light = raylab_core::scene::PointLight::at(Vec3::new(0.0, 11.0, 0.0));
     let settings = raylab_core::render::RenderSettings { width: 1280, height: 720, ..Default::default() };
-    let tracer = raylab_core::trace::Tracer::new(&tree, None, Default::default());
+    let tracer = raylab_core::trace::Tracer::new(&structures, Default::default()).unwrap();
     let frame = raylab_core::render::render(&scene, &tracer, &camera, light, &settings);
     assert_eq!((reference.width(), reference.height()), (1280, 720));
     let (mut off_by_one, mut different) = (0, 0);
@@ -124,9 +126,6 @@ fn the_full_loader_reads_the_same_sponza() {
 /// hit kept the farther one.
 #[test]
 fn every_method_renders_the_same_sponza() {
-    use raylab_core::dacrt::Dacrt;
-    use raylab_core::mbvh::Mbvh;
-    use raylab_core::method::Method;
     use raylab_core::render::{RenderSettings, render};
     use raylab_core::trace::{TraceOptions, Tracer};
     let Some(path) = sponza_path() else {
@@ -134,14 +133,13 @@ fn every_method_renders_the_same_sponza() {
         return;
     };
     let scene = raylab_scene::obj::load(&path).unwrap().scene;
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let (mbvh, dacrt) = (Mbvh::build(&scene), Dacrt::new(&scene));
+    let methods: Vec<Method> = Method::ALL.into_iter().filter(|&m| m != Method::Reference).collect();
+    let structures = Structures::build(&scene, &methods, Purpose::Frames, &StructureParams::default()).unwrap();
     let camera = Camera::look_at(Vec3::new(-12.5, 2.5, 0.0), Vec3::new(10.0, 5.5, 0.0), Vec3::Y, 65.0);
     let light = raylab_core::scene::PointLight::at(Vec3::new(0.0, 11.0, 0.0));
     let settings = RenderSettings { width: 1024, height: 1024, max_depth: 0, ..Default::default() };
     let frame = |method| {
-        let tracer =
-            Tracer::new(&tree, None, TraceOptions { method, ..Default::default() }).with_mbvh(&mbvh).with_dacrt(&dacrt);
+        let tracer = Tracer::new(&structures, TraceOptions { method, ..Default::default() }).unwrap();
         render(&scene, &tracer, &camera, light, &settings).rgba
     };
     let mono = frame(Method::Mono);

@@ -136,18 +136,23 @@ fn counters_add_up() {
 /// this exercises.
 #[test]
 fn coherent_methods_match_brute_force_on_adversarial_rays() {
-    use raylab_core::method::Method;
+    use raylab_core::method::{Method, Purpose, Structure};
     use raylab_core::reference::BruteForce;
+    use raylab_core::structures::{StructureParams, Structures};
     use raylab_core::trace::{TraceOptions, Tracer};
     use raylab_simd::Backend;
     for name in builtin::names() {
         let scene = builtin::build(name, Detail::Test).unwrap();
-        let t = tree(&scene);
+        // The coherent methods on the thesis's tree (both kd-tree slots take its cost model).
+        let params = StructureParams { packet_kd: KdParams::default(), ..StructureParams::default() };
+        let methods = [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone];
+        let structures = Structures::build(&scene, &methods, Purpose::Frames, &params).unwrap();
+        let t = structures.kd(Structure::ThesisKd).unwrap();
         let bf = BruteForce::new(&scene);
-        let rays: Vec<Option<Ray>> = adversarial_rays(&scene, &t, 120, 23).into_iter().map(Some).collect();
-        for method in [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone] {
+        let rays: Vec<Option<Ray>> = adversarial_rays(&scene, t, 120, 23).into_iter().map(Some).collect();
+        for method in methods {
             for backend in Backend::available() {
-                let tracer = Tracer::new(&t, None, TraceOptions { method, backend, ..Default::default() });
+                let tracer = Tracer::new(&structures, TraceOptions { method, backend, ..Default::default() }).unwrap();
                 let mut s = TraversalStats::default();
                 for chunk in rays.chunks(8) {
                     let mut tile = chunk.to_vec();

@@ -2,9 +2,10 @@
 //! the pieces each method traces anyway), every method gives the same depth and normal images, and the
 //! colour scales cover what the frame holds.
 
-use raylab_core::kdtree::{KdParams, KdTree};
-use raylab_core::method::Method;
+use raylab_core::kdtree::KdParams;
+use raylab_core::method::{Method, Purpose};
 use raylab_core::render::{Frame, FrameView, RayOrder, RenderSettings, heat_color, render};
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::builtin::{self, Detail};
 
@@ -13,18 +14,20 @@ const METHODS: [Method; 6] =
 
 struct Setup {
     scene: raylab_core::scene::Scene,
-    tree: KdTree,
+    /// Every method on the thesis's kd-tree (both slots take its cost model).
+    structures: Structures,
 }
 
 impl Setup {
     fn new() -> Self {
         let scene = builtin::build("atrium", Detail::Test).unwrap();
-        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-        Self { scene, tree }
+        let params = StructureParams { packet_kd: KdParams::default(), ..StructureParams::default() };
+        let structures = Structures::build(&scene, &METHODS, Purpose::Frames, &params).unwrap();
+        Self { scene, structures }
     }
 
     fn frame(&self, method: Method, view: FrameView, tile: u32, heat_max: Option<f32>) -> Frame {
-        let tracer = Tracer::new(&self.tree, None, TraceOptions { method, ..Default::default() });
+        let tracer = Tracer::new(&self.structures, TraceOptions { method, ..Default::default() }).unwrap();
         let settings = RenderSettings { width: 45, height: 30, tile, view, heat_max, ..Default::default() };
         let cam = self.scene.default_view().unwrap().camera;
         render(&self.scene, &tracer, &cam, self.scene.lights[0], &settings)
@@ -81,7 +84,7 @@ fn depth_and_normal_views_do_not_depend_on_the_method() {
 #[test]
 fn ray_orders_change_no_pixel_and_heat_maps_ignore_the_order() {
     let s = Setup::new();
-    let tracer = Tracer::new(&s.tree, None, TraceOptions::default());
+    let tracer = Tracer::new(&s.structures, TraceOptions::default()).unwrap();
     let cam = s.scene.default_view().unwrap().camera;
     let mut frames = Vec::new();
     for order in RayOrder::ALL {

@@ -51,9 +51,8 @@ fn closed_meshes_never_leak() {
 /// lower triangle id, as the brute-force reference does, whichever of the two it tests first.
 #[test]
 fn a_shared_edge_goes_to_the_lower_triangle_id() {
-    use raylab_core::dacrt::Dacrt;
-    use raylab_core::mbvh::Mbvh;
-    use raylab_core::method::Method;
+    use raylab_core::method::{Method, Purpose};
+    use raylab_core::structures::{StructureParams, Structures};
     use raylab_core::trace::{TraceOptions, Tracer};
     use raylab_simd::Backend;
     let (a, b, c, d) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::ONE);
@@ -65,8 +64,9 @@ fn a_shared_edge_goes_to_the_lower_triangle_id() {
         m.triangle(first[0], first[1], first[2]);
         m.triangle(second[0], second[1], second[2]);
         let scene = m.build();
-        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-        let (mbvh, dacrt) = (Mbvh::build(&scene), Dacrt::new(&scene));
+        // Every method, the kd-tree ones on the thesis's tree (both slots take its cost model).
+        let params = StructureParams { packet_kd: KdParams::default(), ..StructureParams::default() };
+        let structures = Structures::build(&scene, &Method::ALL, Purpose::Frames, &params).unwrap();
         let bf = BruteForce::new(&scene);
         let mut s = TraversalStats::default();
         // Down onto the edge's midpoint and two other points of it, in a 2x2 tile of identical rays.
@@ -77,9 +77,8 @@ fn a_shared_edge_goes_to_the_lower_triangle_id() {
             let rays = [Some(ray); 4];
             for method in Method::ALL.into_iter().filter(|&m| m != Method::Reference) {
                 for backend in Backend::available() {
-                    let tracer = Tracer::new(&tree, None, TraceOptions { method, backend, ..Default::default() })
-                        .with_mbvh(&mbvh)
-                        .with_dacrt(&dacrt);
+                    let options = TraceOptions { method, backend, ..Default::default() };
+                    let tracer = Tracer::new(&structures, options).unwrap();
                     let mut hits = [None; 4];
                     tracer.intersect_tile(&rays, 2, 2, &mut hits, &mut s);
                     for h in hits {

@@ -302,16 +302,69 @@ pub trait Kernel {
 pub fn dispatch<K: Kernel>(backend: Backend, k: K) -> K::Output {
     match backend {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the guard checked that the CPU has AVX-512F/VL, AVX2, FMA and the bit-manipulation sets,
-        // every feature `run_avx512` is compiled for.
-        Backend::Avx512 if avx512_detected() => unsafe { run_avx512(k) },
+        Backend::Avx512 if avx512_detected() => {
+            dispatch_log::note(Backend::Avx512);
+            // SAFETY: the guard checked that the CPU has AVX-512F/VL, AVX2, FMA and the bit-manipulation sets,
+            // every feature `run_avx512` is compiled for.
+            unsafe { run_avx512(k) }
+        }
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the guard checked that the CPU has AVX2, FMA and the bit-manipulation sets, every feature
-        // `run_avx2` is compiled for.
-        Backend::Avx2 | Backend::Avx512 if avx2_detected() => unsafe { run_avx2(k) },
+        Backend::Avx2 | Backend::Avx512 if avx2_detected() => {
+            dispatch_log::note(Backend::Avx2);
+            // SAFETY: the guard checked that the CPU has AVX2, FMA and the bit-manipulation sets, every feature
+            // `run_avx2` is compiled for.
+            unsafe { run_avx2(k) }
+        }
         #[cfg(target_arch = "x86_64")]
-        Backend::Sse | Backend::Avx2 | Backend::Avx512 => k.run::<sse::F32x4>(),
-        _ => k.run::<scalar::F32x4>(),
+        Backend::Sse | Backend::Avx2 | Backend::Avx512 => {
+            dispatch_log::note(Backend::Sse);
+            k.run::<sse::F32x4>()
+        }
+        _ => {
+            dispatch_log::note(Backend::Scalar);
+            k.run::<scalar::F32x4>()
+        }
+    }
+}
+
+/// Which lanes [`dispatch`] ran, counted per thread when the `dispatch-log` feature is on (tests turn it on);
+/// without it [`dispatch_log::note`] is empty and [`dispatch_log::take`] always returns zeros.
+pub mod dispatch_log {
+    use super::Backend;
+
+    #[cfg(feature = "dispatch-log")]
+    thread_local! {
+        static COUNTS: std::cell::Cell<[u64; 4]> = const { std::cell::Cell::new([0; 4]) };
+    }
+
+    fn slot(b: Backend) -> usize {
+        match b {
+            Backend::Scalar => 0,
+            Backend::Sse => 1,
+            Backend::Avx2 => 2,
+            Backend::Avx512 => 3,
+        }
+    }
+
+    /// Counts one dispatch that ran `lanes`' vectors.
+    #[inline(always)]
+    pub(crate) fn note(lanes: Backend) {
+        #[cfg(feature = "dispatch-log")]
+        COUNTS.with(|c| {
+            let mut v = c.get();
+            v[slot(lanes)] += 1;
+            c.set(v);
+        });
+        #[cfg(not(feature = "dispatch-log"))]
+        let _ = slot(lanes);
+    }
+
+    /// The dispatches this thread ran since the last call, per lane type: scalar, SSE, AVX2, AVX-512.
+    pub fn take() -> [u64; 4] {
+        #[cfg(feature = "dispatch-log")]
+        return COUNTS.with(|c| c.replace([0; 4]));
+        #[cfg(not(feature = "dispatch-log"))]
+        [0; 4]
     }
 }
 

@@ -6,16 +6,14 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::KdTree;
-use raylab_core::mbvh::Mbvh;
-use raylab_core::method::Method;
+use raylab_core::method::{Method, Purpose, Structure};
 use raylab_core::scene::Scene;
 use raylab_core::shadow::Shadows;
+use raylab_core::structures::Structures;
 use raylab_scene::animation::Animation;
 use serde::Serialize;
 
-use crate::loader::LoadedScene;
+use crate::loader::{LoadedScene, viewer_methods};
 use crate::settings::{RenderMode, ViewerSettings};
 
 /// What the last structure update cost; `None` for a structure the frame did not need (left stale, untouched).
@@ -40,22 +38,19 @@ pub struct AnimatedScene {
     start: Instant,
     /// The scene in its current pose.
     pub scene: Scene,
-    /// Its kd-tree (current when the last frame needed it).
-    pub tree: KdTree,
-    /// Its MBVH (current when the last frame needed it).
-    pub mbvh: Mbvh,
-    /// DACRT's copy of its triangles (current when the last frame needed it).
-    pub dacrt: Dacrt,
+    /// Its structures, each current when the last frame needed it.
+    pub structures: Structures,
 }
 
 impl AnimatedScene {
     /// Adds the moving objects to `source`'s scene and builds its structures.
     pub fn new(source: &Arc<LoadedScene>) -> Result<Self, String> {
         let (scene, anim) = Animation::add_movers(&source.scene);
-        let tree = KdTree::build(&scene, &source.params.thesis).map_err(|e| format!("animation: kd-tree: {e}"))?;
-        let mbvh = Mbvh::build(&scene);
-        let dacrt = Dacrt::new(&scene);
-        Ok(Self { source: Arc::clone(source), anim, start: Instant::now(), scene, tree, mbvh, dacrt })
+        let methods: Vec<Method> = viewer_methods().collect();
+        let params = source.structures.params();
+        let structures = Structures::build(&scene, &methods, Purpose::Frames, params)
+            .map_err(|e| format!("animation: kd-tree: {e}"))?;
+        Ok(Self { source: Arc::clone(source), anim, start: Instant::now(), scene, structures })
     }
 
     /// True when this animates `source`.
@@ -72,37 +67,35 @@ impl AnimatedScene {
     /// with `settings` traces.
     pub fn step_at(&mut self, time_s: f64, settings: &ViewerSettings) -> Result<UpdateTimes, String> {
         self.anim.apply(&mut self.scene, time_s as f32)?;
-        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
         let mut out = UpdateTimes { time_s, moving_triangles: self.anim.moving_triangles(), ..UpdateTimes::default() };
         let method = settings.frame_method();
-        if needs_kd_tree(settings) {
-            let t = Instant::now();
-            // The tree of the frame's method ([`crate::loader::TreeParams`]).
-            let params = self.source.params.for_method(method);
-            self.tree = KdTree::build(&self.scene, params).map_err(|e| format!("animation: kd-tree: {e}"))?;
-            out.kd_rebuild_ms = Some(ms(t));
+        let mut update = |which: Structure| -> Result<Option<f64>, String> {
+            let t = self.structures.update_one(&self.scene, which).map_err(|e| format!("animation: {e}"))?;
+            Ok(t.map(|t| t.as_secs_f64() * 1e3))
+        };
+        if let Some(kd) = kd_tree_walked(settings) {
+            // The packet methods' tree may be the thesis's (equal parameters): then the thesis's is rebuilt.
+            out.kd_rebuild_ms = match update(kd)? {
+                None => update(Structure::ThesisKd)?,
+                t => t,
+            };
         }
-        if method.uses_mbvh() {
-            let t = Instant::now();
-            self.mbvh.refit(&self.scene).map_err(|e| format!("animation: {e}"))?;
-            out.mbvh_refit_ms = Some(ms(t));
-        }
-        if method.uses_dacrt() {
-            let t = Instant::now();
-            self.dacrt = Dacrt::new(&self.scene);
-            out.dacrt_setup_ms = Some(ms(t));
+        match method.kernel_structure() {
+            Structure::Mbvh => out.mbvh_refit_ms = update(Structure::Mbvh)?,
+            Structure::Dacrt => out.dacrt_setup_ms = update(Structure::Dacrt)?,
+            _ => {}
         }
         Ok(out)
     }
 }
 
-/// True when a frame with `settings` walks the kd-tree: the kd-tree methods, edge-width shadows (always traced
-/// through it) and multi-sampled shadows (bounded by packets, pyramids or cones over it), in the Whitted and
-/// hybrid modes.
-fn needs_kd_tree(settings: &ViewerSettings) -> bool {
+/// The kd-tree a frame with `settings` walks, if any: the kd-tree methods' own, and the method's
+/// [`Method::frame_kd`] for edge-width shadows (always traced through it) and multi-sampled shadows (bounded
+/// by packets, pyramids or cones over it), in the Whitted and hybrid modes.
+fn kd_tree_walked(settings: &ViewerSettings) -> Option<Structure> {
     let m = settings.frame_method();
-    let structure_free = matches!(m, Method::Mbvh | Method::MbvhRs | Method::Dacrt);
+    let kernel_on_kd = matches!(m.kernel_structure(), Structure::ThesisKd | Structure::PacketKd);
     let shadows_on_kd = settings.mode != RenderMode::Distribution
         && matches!(settings.shadows, Shadows::EdgeWidth { .. } | Shadows::MultiSample { .. });
-    !structure_free || shadows_on_kd
+    (kernel_on_kd || shadows_on_kd).then(|| m.frame_kd()).flatten()
 }

@@ -31,7 +31,6 @@ use std::sync::Arc;
 
 use clap::Parser;
 use raylab_bench::prepare::with_spinner;
-use raylab_core::method::Method;
 
 use crate::camera_path::CameraPath;
 use crate::cli::Cli;
@@ -51,9 +50,10 @@ fn main() -> ExitCode {
 
 fn run(cli: &Cli) -> Result<(), String> {
     cli.validate()?;
-    // Two trees when their cost models differ (`KdParams::for_method`): each method walks its own.
-    let kd = loader::TreeParams { thesis: cli.kd.params()?, packets: cli.kd.params_for(Method::Mft)? };
-    let scene = with_spinner("loading scene and building the kd-tree", || loader::load_now(&cli.scene, &kd, &|_| {}))?;
+    // Two kd-trees when their cost models differ (`StructureParams`): each method walks its own.
+    let kd = cli.kd.structure_params()?;
+    let scene =
+        with_spinner("loading scene and building its structures", || loader::load_now(&cli.scene, &kd, &|_| {}))?;
     let settings = ViewerSettings {
         mode: cli.mode,
         trace: cli.method.options(),

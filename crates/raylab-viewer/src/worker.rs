@@ -13,11 +13,9 @@ use raylab_core::method::Method;
 use raylab_core::render::{Frame, StageTimes, render};
 use raylab_core::scene::{Camera, PointLight};
 use raylab_core::stats::TraversalStats;
-use raylab_core::trace::Tracer;
+use raylab_core::structures::Structures;
+use raylab_core::trace::{TraceOptions, Tracer};
 
-use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::KdTree;
-use raylab_core::mbvh::Mbvh;
 use raylab_core::scene::Scene;
 
 use raylab_core::ray::Ray;
@@ -102,29 +100,33 @@ pub struct HybridFrame {
 }
 
 /// The scene and structures a frame traces: the loaded ones, or the animated copies.
-pub struct Structures<'a> {
+#[derive(Clone, Copy)]
+pub struct Traced<'a> {
     /// The scene.
     pub scene: &'a Scene,
-    /// Its kd-tree.
-    pub tree: &'a KdTree,
-    /// Its MBVH.
-    pub mbvh: &'a Mbvh,
-    /// DACRT's triangle copy.
-    pub dacrt: &'a Dacrt,
+    /// Its structures.
+    pub structures: &'a Structures,
+}
+
+impl Traced<'_> {
+    /// A tracer with `options` over these structures. Every viewer method's structures are built for frames
+    /// ([`crate::loader::viewer_methods`]), so only the reference, which the viewer does not offer, is refused.
+    fn tracer(&self, options: TraceOptions) -> Tracer<'_> {
+        Tracer::new(self.structures, options).expect("the viewer builds every method's structures for frames")
+    }
 }
 
 impl LoadedScene {
-    /// The loaded scene's structures for frames traced with `method` (its kd-tree is the method's,
-    /// [`LoadedScene::kd_for`]).
-    pub fn structures(&self, method: Method) -> Structures<'_> {
-        Structures { scene: &self.scene, tree: &self.kd_for(method).tree, mbvh: &self.mbvh, dacrt: &self.dacrt }
+    /// The loaded scene and its structures.
+    pub fn traced(&self) -> Traced<'_> {
+        Traced { scene: &self.scene, structures: &self.structures }
     }
 }
 
 impl AnimatedScene {
-    /// The animated scene's structures.
-    pub fn structures(&self) -> Structures<'_> {
-        Structures { scene: &self.scene, tree: &self.tree, mbvh: &self.mbvh, dacrt: &self.dacrt }
+    /// The animated scene and its structures.
+    pub fn traced(&self) -> Traced<'_> {
+        Traced { scene: &self.scene, structures: &self.structures }
     }
 }
 
@@ -335,8 +337,7 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn(), priority: Tra
                     progressive = Some(Progressive { job: job.clone(), acc, passes: 0 });
                 }
                 let Some(p) = progressive.as_mut() else { continue };
-                let s =
-                    moving.map_or_else(|| job.scene.structures(job.settings.frame_method()), AnimatedScene::structures);
+                let s = moving.map_or_else(|| job.scene.traced(), AnimatedScene::traced);
                 let mut rendered = pool.install(|| distribution_pass(p, &s));
                 rendered.animation = update;
                 // Keep refining while the view stays, up to the pass limit.
@@ -346,8 +347,7 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn(), priority: Tra
                 send(tx, wake, WorkerEvent::Frame(Box::new(rendered)));
             }
             Task::Frame(job) => {
-                let s =
-                    moving.map_or_else(|| job.scene.structures(job.settings.frame_method()), AnimatedScene::structures);
+                let s = moving.map_or_else(|| job.scene.traced(), AnimatedScene::traced);
                 let mut rendered = pool.install(|| trace_in(&s, &job, job.settings.trace.method));
                 rendered.animation = update;
                 shared.lock().repeat = (job.settings.continuous || job.settings.animate).then(|| job.clone());
@@ -375,8 +375,8 @@ fn run(shared: &Shared, tx: &Sender<WorkerEvent>, wake: &dyn Fn(), priority: Tra
                     }
                 }
                 let s = match (&animated, update) {
-                    (Some(a), Some(_)) => a.structures(),
-                    _ => r.job.scene.structures(r.job.settings.frame_method()),
+                    (Some(a), Some(_)) => a.traced(),
+                    _ => r.job.scene.traced(),
                 };
                 let mut rendered = pool.install(|| reflections(&r, &s, &mut rbuffer));
                 rendered.animation = update;
@@ -416,7 +416,7 @@ struct Interlaced {
 /// k-th row in turn when interlacing (the other rows keep the previous frame's reflections). The readback
 /// kept only the reflective pixels; those in the traced rows get rays, and only they are traced and written,
 /// so the cost follows the mirrors on screen rather than the G-buffer's size.
-fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rendered {
+fn reflections(r: &ReflectionJob, s: &Traced, kept: &mut Interlaced) -> Rendered {
     let t0 = Instant::now();
     let job = &r.job;
     let g = &r.gbuffer;
@@ -441,8 +441,8 @@ fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rend
         .filter_map(|t| reflection_ray(job.camera.eye, &g.pixel(&raster, t), eps).map(|r| (t.index, r)))
         .collect();
     let settings = job.settings.render_settings(w, h);
-    let options = raylab_core::trace::TraceOptions { method: job.settings.hybrid.method, ..job.settings.trace };
-    let tracer = Tracer::new(s.tree, None, options).with_mbvh(s.mbvh).with_dacrt(s.dacrt);
+    let options = TraceOptions { method: job.settings.hybrid.method, ..job.settings.trace };
+    let tracer = s.tracer(options);
     let (colors, stats, stages) = shade_reflection_set(s.scene, &tracer, &job.camera, job.light, &settings, &set);
     // The traced rows start black; then their reflective pixels get their colours.
     let rows = kept.colors.chunks_mut(row_len).zip(kept.rgba.chunks_mut(row_len));
@@ -478,15 +478,13 @@ fn reflections(r: &ReflectionJob, s: &Structures, kept: &mut Interlaced) -> Rend
 
 /// Traces `job` with `method` on the current rayon pool, in the loaded scene.
 pub fn trace_frame(job: &Job, method: Method) -> Rendered {
-    trace_in(&job.scene.structures(method), job, method)
+    trace_in(&job.scene.traced(), job, method)
 }
 
 /// Traces `job` with `method` in the scene and structures `s`.
-fn trace_in(s: &Structures, job: &Job, method: Method) -> Rendered {
+fn trace_in(s: &Traced, job: &Job, method: Method) -> Rendered {
     let settings = job.settings.render_settings(job.size.0, job.size.1);
-    let tracer = Tracer::new(s.tree, None, raylab_core::trace::TraceOptions { method, ..job.settings.trace })
-        .with_mbvh(s.mbvh)
-        .with_dacrt(s.dacrt);
+    let tracer = s.tracer(TraceOptions { method, ..job.settings.trace });
     let t0 = Instant::now();
     let frame = render(s.scene, &tracer, &job.camera, job.light, &settings);
     Rendered {
@@ -500,11 +498,11 @@ fn trace_in(s: &Structures, job: &Job, method: Method) -> Rendered {
 }
 
 /// Adds one distribution pass, traced in `s`, to `p` on the current rayon pool and returns the refined image.
-fn distribution_pass(p: &mut Progressive, s: &Structures) -> Rendered {
+fn distribution_pass(p: &mut Progressive, s: &Traced) -> Rendered {
     let job = &p.job;
     let (w, h) = (p.acc.width, p.acc.height);
     let settings = job.settings.distribution.settings(w, h, job.settings.tile);
-    let tracer = Tracer::new(s.tree, None, job.settings.trace).with_mbvh(s.mbvh).with_dacrt(s.dacrt);
+    let tracer = s.tracer(job.settings.trace);
     let mut camera = job.camera;
     camera.aperture = job.settings.distribution.aperture;
     let light = job.light.soft();

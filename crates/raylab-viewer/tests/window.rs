@@ -10,11 +10,11 @@ use std::process::Command;
 
 use raylab_bench::args::SceneArgs;
 use raylab_bench::still::render_still;
-use raylab_core::kdtree::KdParams;
-use raylab_core::method::Method;
+use raylab_core::method::{Method, Purpose};
 use raylab_core::render::{FrameView, RayOrder, RenderSettings};
 use raylab_core::scene::PointLight;
 use raylab_core::shadow::{SampleBound, ShadowKind};
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::trace::TraceOptions;
 
 const W: u32 = 720;
@@ -90,8 +90,10 @@ fn reference(method: Method, shadows: ShadowKind, show: FrameView) -> image::Rgb
         heat_max: None,
     };
     let options = TraceOptions { method, ..TraceOptions::default() };
-    let kd = KdParams::for_method(method);
-    render_still(&SceneArgs::named("atrium"), &kd, options, settings, 2, 1).unwrap().image().unwrap()
+    render_still(&SceneArgs::named("atrium"), &StructureParams::default(), options, settings, 2, 1)
+        .unwrap()
+        .image()
+        .unwrap()
 }
 
 fn rect(v: &serde_json::Value) -> [f32; 4] {
@@ -186,8 +188,6 @@ fn heat_maps_and_offscreen_runs_match_the_cli() {
 #[test]
 fn distribution_mode_shows_the_accumulated_passes() {
     use raylab_core::distribution::{Accumulator, DistributionSettings, render_pass};
-    use raylab_core::kdtree::KdTree;
-    use raylab_core::mbvh::Mbvh;
     use raylab_core::trace::Tracer;
 
     let dir = tempfile::tempdir().unwrap();
@@ -198,9 +198,8 @@ fn distribution_mode_shows_the_accumulated_passes() {
     let scene_args = SceneArgs::named("atrium");
     let scene = raylab_scene::load(&scene_args.source()).unwrap().scene;
     let (camera, light) = scene_args.camera_and_light(&scene).unwrap();
-    let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-    let mbvh = Mbvh::build(&scene);
-    let tracer = Tracer::new(&tree, None, TraceOptions::default()).with_mbvh(&mbvh);
+    let structures = Structures::build(&scene, &[Method::Mono], Purpose::Rays, &StructureParams::default()).unwrap();
+    let tracer = Tracer::for_rays(&structures, TraceOptions::default()).unwrap();
     let settings = DistributionSettings {
         width: W,
         height: H,
@@ -272,8 +271,8 @@ fn hybrid_mode_reflections_match_the_cpu_renderer() {
     let args = SceneArgs::named("atrium");
     let (scene, _) = raylab_bench::prepare::load_scene(&args.source()).unwrap();
     let (camera, light) = args.camera_and_light(&scene).unwrap();
-    let tree = raylab_core::kdtree::KdTree::build(&scene, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let structures = Structures::build(&scene, &[Method::Mono], Purpose::Frames, &StructureParams::default()).unwrap();
+    let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
     let settings = RenderSettings { width: W, height: H, tile: TILE, ..RenderSettings::default() };
     let want = reference_reflections(&scene, &tracer, &camera, light, &settings);
     let reflective = want.iter().filter(|c| c.is_some()).count();
@@ -311,8 +310,8 @@ fn hybrid_mode_reflections_match_the_cpu_renderer() {
     assert!(stats["animation"]["dacrt_setup_ms"].is_number(), "{}", stats["animation"]);
     let (mut moved, anim) = raylab_scene::animation::Animation::add_movers(&scene);
     anim.apply(&mut moved, t as f32).unwrap();
-    let tree = raylab_core::kdtree::KdTree::build(&moved, &KdParams::default()).unwrap();
-    let tracer = Tracer::new(&tree, None, TraceOptions::default());
+    let structures = Structures::build(&moved, &[Method::Mono], Purpose::Frames, &StructureParams::default()).unwrap();
+    let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
     let want = reference_reflections(&moved, &tracer, &camera, light, &settings);
     let db = rbuffer_psnr(&traced, &want);
     assert!(db >= 35.0, "animated: R-buffer {db:.1} dB from the CPU renderer's reflections at t = {t}");

@@ -8,11 +8,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::KdTree;
-use raylab_core::mbvh::Mbvh;
-use raylab_core::method::Method;
-use raylab_core::reference::BruteForce;
+use raylab_core::method::{Method, Structure};
+use raylab_core::structures::Structures;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 use raylab_scene::animation::Animation;
@@ -82,7 +79,7 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
     let (base, _) = load_scene(&a.scene.source())?;
     let (camera, light) = a.scene.camera_and_light(&base)?;
     let (mut scene, anim) = Animation::add_movers(&base);
-    let params = a.kd.params()?;
+    let params = a.kd.structure_params()?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string())?;
     let methods = [
         (Method::Mono, "kd-tree rebuilt"),
@@ -90,31 +87,31 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
         (Method::Dacrt, "triangles copied, top divided"),
     ];
     let mut rows = vec![Row::default(); methods.len()];
-    let mut mbvh = pool.install(|| Mbvh::build(&scene));
+    // The methods' structures and the brute force the results are checked against, updated every frame.
+    let needs = [Structure::ThesisKd, Structure::Mbvh, Structure::Dacrt, Structure::Reference];
+    let mut structures =
+        pool.install(|| Structures::build_these(&scene, &needs, &params)).map_err(|e| e.to_string())?;
     let mut rays = 0;
     for f in 0..a.frames {
         anim.apply(&mut scene, f as f32 * a.step)?;
-        let t = Instant::now();
-        let tree = pool.install(|| KdTree::build(&scene, &params)).map_err(|e| format!("kd-tree: {e}"))?;
-        let kd_ms = t.elapsed().as_secs_f64() * 1e3;
-        let refit_ms = mbvh.refit(&scene).map_err(|e| e.to_string())?.as_secs_f64() * 1e3;
-        let t = Instant::now();
-        let dacrt = Dacrt::new(&scene);
-        let dacrt_ms = t.elapsed().as_secs_f64() * 1e3;
+        let times = pool.install(|| structures.update(&scene)).map_err(|e| e.to_string())?;
+        let ms = |which: Structure| times.iter().find(|(s, _)| *s == which).map_or(0.0, |(_, t)| t.as_secs_f64() * 1e3);
+        let updates = [ms(Structure::ThesisKd), ms(Structure::Mbvh), ms(Structure::Dacrt)];
+        let (Some(tree), Some(reference)) = (structures.kd(Structure::ThesisKd), structures.reference()) else {
+            unreachable!("built above");
+        };
         let workload =
-            WorkloadBuilder::new(&scene, &camera, light.position, a.width as u32, a.height as u32, &tree).build(a.kind);
+            WorkloadBuilder::new(&scene, &camera, light.position, a.width as u32, a.height as u32, tree).build(a.kind);
         rays = workload.ray_count();
-        let reference = BruteForce::new(&scene);
         let mut checksums = Vec::new();
-        for ((method, _), (row, update)) in methods.iter().zip(rows.iter_mut().zip([kd_ms, refit_ms, dacrt_ms])) {
-            let tracer = Tracer::new(&tree, None, TraceOptions { method: *method, ..TraceOptions::default() })
-                .with_mbvh(&mbvh)
-                .with_dacrt(&dacrt);
+        for ((method, _), (row, update)) in methods.iter().zip(rows.iter_mut().zip(updates)) {
+            let options = TraceOptions { method: *method, ..TraceOptions::default() };
+            let tracer = Tracer::for_rays(&structures, options).map_err(|e| e.to_string())?;
             let tile = if method.uses_dacrt() { DACRT_SET_TILE } else { HARNESS_TILE };
             let t = Instant::now();
             let (results, _) = pool.install(|| trace_once(&tracer, &workload, tile));
             let trace = t.elapsed().as_secs_f64() * 1e3;
-            validate(&reference, &workload, &results, a.validate as usize)
+            validate(reference, &workload, &results, a.validate as usize)
                 .map_err(|m| format!("frame {f}: validation failed ({method}): {m}"))?;
             checksums.push(summarize(&results));
             row.update_ms.push(update);

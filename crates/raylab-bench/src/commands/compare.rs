@@ -11,11 +11,10 @@ use std::process::Command;
 
 use clap::Args;
 use raylab_core::dacrt::Dacrt;
-use raylab_core::kdtree::KdTree;
 use raylab_core::mbvh::Mbvh;
-use raylab_core::method::Method;
-use raylab_core::reference::BruteForce;
+use raylab_core::method::{Method, Purpose, Structure};
 use raylab_core::scene::Scene;
+use raylab_core::structures::Structures;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_core::workload::{RayKind, Workload, WorkloadBuilder};
 use serde::Serialize;
@@ -24,7 +23,7 @@ use serde_json::json;
 use crate::args::{ImageArgs, KdArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
 use crate::output::{markdown_header, print_markdown, write_json};
-use crate::prepare::{build_tree, load_scene, with_spinner};
+use crate::prepare::{build_structures, build_tree, load_scene, with_spinner};
 use crate::timing::{DACRT_SET_TILE as DACRT_TILE, HARNESS_TILE, TraceReport, measure, tile_for_group, validate};
 
 /// Compares raylab's single-ray kd-tree with Embree's single-ray API on the harness's rays.
@@ -251,17 +250,15 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     embree.merge(builds_run, &mut embree_rounds);
 
     // The thesis's tree for single rays, and the one with the packet methods' cost model
-    // (`KdParams::for_method`) for packets, frustums, MFT and cones.
-    let params = [a.kd.params()?, a.kd.params_for(Method::Mft)?];
+    // (`StructureParams::packet_kd`) for packets, frustums, MFT and cones: their builds timed per thread count.
+    let structure_params = a.kd.structure_params()?;
+    let params = [structure_params.kd, structure_params.packet_kd];
     let mut builds = Vec::new();
-    let mut trees: [Option<KdTree>; 2] = [None, None];
     for &t in &a.threads {
         let mut times = [Vec::new(), Vec::new()];
         for _ in 0..a.builds {
             for (k, p) in params.iter().enumerate() {
-                let built = build_tree(&scene, p, t as usize)?;
-                times[k].push(built.build_time().as_secs_f64());
-                trees[k] = Some(built);
+                times[k].push(build_tree(&scene, p, t as usize)?.build_time().as_secs_f64());
             }
         }
         let [thesis, packets] = times.map(|mut v| {
@@ -270,10 +267,17 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
         });
         builds.push((t, thesis, packets));
     }
-    let [Some(tree), Some(packet_tree)] = trees else { return Err("--threads: no thread count given".into()) };
-    let reference = BruteForce::new(&scene);
+    // Every traced method's structures, and the brute force that validates them.
+    let mut methods = vec![Method::Mono, Method::Reference];
+    methods.extend(a.methods.iter().filter(|m| m.uses_packets()));
+    methods.extend(&a.incoherent);
+    let threads = a.threads.iter().copied().max().ok_or("--threads: no thread count given")? as usize;
+    let structures = build_structures(&scene, &methods, Purpose::Rays, &structure_params, threads)?;
+    let (Some(tree), Some(reference)) = (structures.kd(Structure::ThesisKd), structures.reference()) else {
+        unreachable!("built above");
+    };
     let (w, h) = a.image.size();
-    let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, &tree));
+    let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, tree));
     // Per round and ray kind: the harness first, then raylab's single rays, then the coherent methods (primary
     // and shadow rays) or the incoherent ones (diffuse rays).
     let mut rounds = Vec::new();
@@ -286,16 +290,17 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
             embree.merge(run, &mut embree_rounds);
             let workload = wb.build(kind);
             for &t in &a.threads {
-                let tracer = Tracer::new(&tree, None, TraceOptions { method: Method::Mono, ..Default::default() });
+                let options = TraceOptions { method: Method::Mono, ..Default::default() };
+                let tracer = Tracer::for_rays(&structures, options).map_err(|e| e.to_string())?;
                 let runs = (t as usize, a.warmup as usize, a.reps as usize);
                 let (report, results) = measure(&tracer, &workload, HARNESS_TILE, runs, None)?;
-                validate(&reference, &workload, &results, 256).map_err(|m| format!("validation failed: {m}"))?;
+                validate(reference, &workload, &results, 256).map_err(|m| format!("validation failed: {m}"))?;
                 this.ours.push(report);
             }
             if kind == RayKind::Diffuse {
                 // Incoherent rays: the MBVH methods (MBVH RS paper) and DACRT (seed 003).
                 if !a.incoherent.is_empty() {
-                    let (mbvh_times, setup, rows) = incoherent_runs(a, &scene, &tree, &reference, &workload)?;
+                    let (mbvh_times, setup, rows) = incoherent_runs(a, &scene, &structures, &workload)?;
                     (mbvh_builds, dacrt_setup, this.incoherent) = (mbvh_times, setup, rows);
                 }
                 continue;
@@ -305,10 +310,11 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                 let tiles: Vec<u64> = if method.uses_tiles() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
                 for &tile in &tiles {
                     for &t in &a.threads {
-                        let tracer = Tracer::new(&packet_tree, None, TraceOptions { method, ..Default::default() });
+                        let options = TraceOptions { method, ..Default::default() };
+                        let tracer = Tracer::for_rays(&structures, options).map_err(|e| e.to_string())?;
                         let runs = (t as usize, a.warmup as usize, a.reps as usize);
                         let (report, results) = measure(&tracer, &workload, tile as u32, runs, None)?;
-                        validate(&reference, &workload, &results, 256)
+                        validate(reference, &workload, &results, 256)
                             .map_err(|m| format!("validation failed ({method} tile {tile}): {m}"))?;
                         this.coherent.push((method, tile, report));
                     }
@@ -521,33 +527,29 @@ impl Round {
 /// method's report, labelled with its RS group size where it has one.
 type Incoherent = (Vec<(u64, f64)>, Option<f64>, Vec<(String, TraceReport)>);
 
-/// Builds the MBVH (per thread count, `--builds` times) and DACRT's setup as the methods need, then measures
-/// and validates the incoherent methods on the diffuse rays `workload`: the MBVH methods (MBVH RS paper, each
-/// RS group size) and DACRT (seed 003).
+/// Times the MBVH's build (per thread count, `--builds` times) as the methods need, then measures and
+/// validates the incoherent methods on the diffuse rays `workload` with `structures`: the MBVH methods (MBVH RS
+/// paper, each RS group size) and DACRT (seed 003).
 fn incoherent_runs(
     a: &CompareArgs,
     scene: &Scene,
-    tree: &KdTree,
-    reference: &BruteForce,
+    structures: &Structures,
     workload: &Workload,
 ) -> Result<Incoherent, String> {
-    let mut mbvh = None;
+    let reference = structures.reference().ok_or("the brute-force reference was not built")?;
     let mut mbvh_builds = Vec::new();
     if a.incoherent.iter().any(|m| m.uses_mbvh()) {
         for &t in &a.threads {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(t as usize).build().map_err(|e| e.to_string())?;
             let mut times = Vec::new();
             for _ in 0..a.builds {
-                let built = pool.install(|| Mbvh::build(scene));
-                times.push(built.build_time().as_secs_f64());
-                mbvh = Some(built);
+                times.push(pool.install(|| Mbvh::build(scene)).build_time().as_secs_f64());
             }
             times.sort_by(f64::total_cmp);
             mbvh_builds.push((t, times[times.len() / 2]));
         }
     }
-    let dacrt = a.incoherent.iter().any(|m| m.uses_dacrt()).then(|| Dacrt::new(scene));
-    let dacrt_setup = dacrt.as_ref().map(|d| d.setup_time().as_secs_f64());
+    let dacrt_setup = structures.dacrt().map(|d| d.setup_time().as_secs_f64());
     let runs = a.incoherent.iter().flat_map(|&m| {
         let groups: Vec<Option<u64>> =
             if m == Method::MbvhRs { a.rs_groups.iter().map(|&g| Some(g)).collect() } else { vec![None] };
@@ -557,13 +559,7 @@ fn incoherent_runs(
     for (method, group) in runs {
         for &t in &a.threads {
             let options = TraceOptions { method, stream_group: group.map(|g| g as usize), ..Default::default() };
-            let mut tracer = Tracer::new(tree, None, options);
-            if let Some(m) = &mbvh {
-                tracer = tracer.with_mbvh(m);
-            }
-            if let Some(d) = &dacrt {
-                tracer = tracer.with_dacrt(d);
-            }
+            let tracer = Tracer::for_rays(structures, options).map_err(|e| e.to_string())?;
             let tile = match group {
                 _ if method.uses_dacrt() => DACRT_TILE,
                 Some(g) => tile_for_group(HARNESS_TILE, g as u32),

@@ -7,16 +7,16 @@ use std::path::PathBuf;
 
 use clap::Args;
 use raylab_core::distribution::{Accumulator, BounceStats, DistributionSettings, render_pass};
-use raylab_core::mbvh::Mbvh;
-use raylab_core::method::Method;
+use raylab_core::method::{Method, Purpose};
 use raylab_core::stats::TraversalStats;
+use raylab_core::structures::StructureParams;
 use raylab_core::trace::{TraceOptions, Tracer};
 use serde_json::json;
 
 use crate::args::{KdArgs, SceneArgs, in_range, parse_non_negative};
 use crate::env::Environment;
 use crate::output::{markdown_header, print_markdown, write_json};
-use crate::prepare::{build_tree, load_scene, with_spinner};
+use crate::prepare::{build_structures, load_scene};
 
 /// Traces the distribution workload with each method and prints per-bounce speeds and counters.
 #[derive(Args, Debug)]
@@ -82,9 +82,11 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
     let (mut camera, light) = a.scene.camera_and_light(&scene)?;
     camera.aperture = a.aperture;
     let light = light.soft();
-    let tree = build_tree(&scene, &a.kd.params()?, a.threads as usize)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string())?;
-    let mbvh = with_spinner("building MBVH", || pool.install(|| Mbvh::build(&scene)));
+    // The paper's workload compares every method on the thesis's kd-tree cost model (both slots take it).
+    let thesis = a.kd.params()?;
+    let params = StructureParams { packet_kd: thesis, ..a.kd.structure_params()? };
+    let structures = build_structures(&scene, &a.methods, Purpose::Rays, &params, a.threads as usize)?;
     let settings = |tile: u64| DistributionSettings {
         width: a.width as u32,
         height: a.height as u32,
@@ -94,13 +96,14 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
         glossy_exponent: a.glossy_exponent,
         all_glossy: !a.materials,
     };
-    let run_one = |method: Method, tile: u64| -> (Vec<BounceStats>, Accumulator, f64) {
+    let run_one = |method: Method, tile: u64| -> Result<(Vec<BounceStats>, Accumulator, f64), String> {
         let s = settings(tile);
-        let tracer = Tracer::new(&tree, None, TraceOptions { method, ..TraceOptions::default() }).with_mbvh(&mbvh);
+        let options = TraceOptions { method, ..TraceOptions::default() };
+        let tracer = Tracer::for_rays(&structures, options).map_err(|e| e.to_string())?;
         let mut acc = Accumulator::new(s.width, s.height);
         let t0 = std::time::Instant::now();
         let stats = pool.install(|| render_pass(&scene, &tracer, &camera, light, &s, 0, &mut acc));
-        (stats, acc, t0.elapsed().as_secs_f64())
+        Ok((stats, acc, t0.elapsed().as_secs_f64()))
     };
     let cmd: Vec<String> = std::env::args().collect();
     let mut md = markdown_header(&env, &cmd);
@@ -124,7 +127,7 @@ pub fn run(a: &DistributionArgs) -> Result<(), String> {
     let mut runs: Vec<Run> = Vec::with_capacity(rows.len());
     for (method, tile, sweep) in rows {
         eprintln!("tracing with {method}, tile {tile}");
-        let (bounces, acc, _) = run_one(method, tile);
+        let (bounces, acc, _) = run_one(method, tile)?;
         let group = (method == Method::MbvhRs).then(|| group(tile));
         runs.push(Run { method, group, sweep, bounces });
         if first_image.is_none() {

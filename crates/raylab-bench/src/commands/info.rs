@@ -28,7 +28,7 @@ pub struct InfoArgs {
 /// Runs the command.
 pub fn run(a: &InfoArgs) -> Result<(), String> {
     let (raylab_scene::Loaded { scene, warnings }, load_s) = load_scene_verbose(&a.scene.source())?;
-    let params = a.kd.params_for(a.method)?;
+    let params = *a.kd.structure_params()?.kd_for(a.method);
     let tree = build_tree(&scene, &params, a.threads as usize)?;
     let st = tree.stats();
     let b = scene.bounds();

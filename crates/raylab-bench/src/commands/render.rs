@@ -86,10 +86,12 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
     let frames = a.frames as usize;
     let env = a.json.then(Environment::detect);
     let options = a.m.options();
-    let still = render_still(&a.scene, &a.kd.params_for(a.m.method)?, options, settings, threads, frames)?;
+    let still = render_still(&a.scene, &a.kd.structure_params()?, options, settings, threads, frames)?;
     still.image()?.save(&a.out).map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
     let shown = std::fs::canonicalize(&a.out).unwrap_or_else(|_| a.out.clone());
-    let Still { scene, tree, camera, light, frame, load_s, render_s, frame_s } = &still;
+    let Still { scene, structures, camera, light, frame, load_s, render_s, frame_s } = &still;
+    let kd_params = structures.params().kd_for(a.m.method);
+    let kd_build_s = structures.kd_for(a.m.method).map_or(0.0, |t| t.build_time().as_secs_f64());
     let stats = &frame.stats;
     let (min, max) = frame_s.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| (lo.min(t), hi.max(t)));
     if let Some(env) = env {
@@ -103,8 +105,9 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
             "options": options,
             "threads": threads,
             "load_seconds": load_s,
-            "kd_build_seconds": tree.build_time().as_secs_f64(),
-            "kd_params": tree.params(),
+            "kd_build_seconds": kd_build_s,
+            "kd_params": kd_params,
+            "structures": structures.builds(),
             "frames": frames,
             "frame_seconds": { "median": render_s, "min": min, "max": max, "each": frame_s },
             "fps": 1.0 / render_s,
@@ -122,12 +125,12 @@ pub fn run(a: &RenderArgs) -> Result<(), String> {
         return Ok(());
     }
     println!(
-        "{}: {} triangles, loaded in {:.3} s, kd-tree (C_trav {}) in {:.3} s; rendered {}x{} with {} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",
+        "{}: {} triangles, loaded in {:.3} s, structures (kd-tree C_trav {}) in {:.3} s; rendered {}x{} with {} in {:.3} s ({} threads, {:.2} Mrays/s, {:.1} nodes/ray)",
         a.scene.scene,
         scene.triangle_count(),
         load_s,
-        tree.params().c_trav,
-        tree.build_time().as_secs_f64(),
+        kd_params.c_trav,
+        structures.build_seconds(),
         frame.width,
         frame.height,
         a.m.method,

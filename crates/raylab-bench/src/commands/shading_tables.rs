@@ -11,6 +11,7 @@ use raylab_core::method::Method;
 use raylab_core::render::{Frame, RenderSettings, StageTimes, render};
 use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::shadow::{SampleBound, Shadows};
+use raylab_core::structures::Structures;
 use raylab_core::trace::{TraceOptions, Tracer};
 
 use serde_json::{Value, json};
@@ -42,12 +43,18 @@ pub struct Subject<'a> {
     pub name: &'a str,
     /// The scene.
     pub scene: &'a Scene,
-    /// Its kd-tree.
-    pub tree: &'a KdTree,
+    /// Its structures (MFT's kd-tree).
+    pub structures: &'a Structures,
     /// The camera.
     pub camera: Camera,
     /// The light (its radius is replaced where a table fixes one).
     pub light: PointLight,
+}
+
+impl Subject<'_> {
+    fn kd_tree(&self) -> &KdTree {
+        self.structures.kd_for(Method::Mft).expect("the shading tables build MFT's structures for frames")
+    }
 }
 
 impl ShadingRun<'_> {
@@ -91,7 +98,8 @@ impl ShadingRun<'_> {
     }
 
     fn tracer<'t>(s: &'t Subject) -> Tracer<'t> {
-        Tracer::new(s.tree, None, TraceOptions { method: Method::Mft, ..TraceOptions::default() })
+        let options = TraceOptions { method: Method::Mft, ..TraceOptions::default() };
+        Tracer::new(s.structures, options).expect("the shading tables build MFT's structures for frames")
     }
 
     fn table_5_1(&self, subjects: &[Subject], md: &mut String, records: &mut Vec<Value>) {
@@ -194,7 +202,8 @@ impl ShadingRun<'_> {
             let tracer = Self::tracer(s);
             let c = self.timed(s, &tracer, s.light, Shadows::Hard, RenderSettings::DEFAULT_DEPTH);
             let (w, h, backend) = (self.size.0, self.size.1, tracer.options.backend);
-            let per_test = crate::isect_cost::seconds_per_packet_test(s.tree, &s.camera, w, h, backend).unwrap_or(0.0);
+            let per_test =
+                crate::isect_cost::seconds_per_packet_test(s.kd_tree(), &s.camera, w, h, backend).unwrap_or(0.0);
             let split = c.stages.split(per_test);
             let total: f64 = split.iter().sum();
             let mut v = self.record("3.1", s, &Shadows::Hard, s.light.radius, RenderSettings::DEFAULT_DEPTH, &c);

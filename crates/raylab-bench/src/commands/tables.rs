@@ -8,10 +8,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use raylab_core::method::Method;
+use raylab_core::method::{Method, Purpose};
 use raylab_core::render::{RenderSettings, StageTimes, render};
 use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::shadow::Shadows;
+use raylab_core::structures::StructureParams;
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_simd::Backend;
 use serde::Serialize;
@@ -21,7 +22,7 @@ use super::shading_tables::{ShadingRun, Subject};
 use crate::args::{KdArgs, SceneArgs, in_range};
 use crate::env::Environment;
 use crate::output::{markdown_header, print_markdown, write_json};
-use crate::prepare::{build_tree, load_scene};
+use crate::prepare::{build_structures, load_scene};
 
 /// Regenerates thesis Tables 4.1-4.5 for the built-in scenes and the scene given with `--scene` (for
 /// instance the shared Sponza with its benchmark view).
@@ -211,7 +212,9 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
         max_depth: 0,
         ..Default::default()
     };
+    // The thesis's tables: every method walks the thesis's tree (both kd-tree slots take its cost model).
     let params = a.kd.params()?;
+    let structure_params = StructureParams { packet_kd: params, ..a.kd.structure_params()? };
     let backend = a.backend.unwrap_or_else(|| {
         let avail = Backend::available();
         avail.iter().copied().find(|&b| b == Backend::Sse).unwrap_or(avail[0])
@@ -228,14 +231,17 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
     }
     let mut rows = Vec::new();
     for (name, scene, cam, light, ..) in scenes.iter().filter(|s| s.4) {
-        let tree = build_tree(scene, &params, a.threads as usize)?;
-        let tracer =
-            |method, cull| Tracer::new(&tree, None, TraceOptions { method, cull, backend, ..Default::default() });
+        let methods = [Method::Packet, Method::Frustum, Method::Mft, Method::Cone, Method::MftCone];
+        let structures = build_structures(scene, &methods, Purpose::Frames, &structure_params, a.threads as usize)?;
+        let tracer = |method, cull| {
+            Tracer::new(&structures, TraceOptions { method, cull, backend, ..Default::default() })
+                .map_err(|e| e.to_string())
+        };
         eprintln!("measuring {name} ({} triangles)", scene.triangle_count());
         // Every configuration of the scene's row, rendered in turn, round by round (`measure_interleaved`).
-        let (packet, unculled) = (tracer(Method::Packet, true), tracer(Method::Frustum, false));
-        let (frustum, mft) = (tracer(Method::Frustum, true), tracer(Method::Mft, true));
-        let (cone, mft_cone) = (tracer(Method::Cone, true), tracer(Method::MftCone, true));
+        let (packet, unculled) = (tracer(Method::Packet, true)?, tracer(Method::Frustum, false)?);
+        let (frustum, mft) = (tracer(Method::Frustum, true)?, tracer(Method::Mft, true)?);
+        let (cone, mft_cone) = (tracer(Method::Cone, true)?, tracer(Method::MftCone, true)?);
         let mut configs = vec![(&packet, settings(16)), (&unculled, settings(8))];
         configs.extend(tiles.iter().map(|&t| (&frustum, settings(t))));
         configs.extend(tiles.iter().map(|&t| (&mft, settings(t))));
@@ -384,19 +390,25 @@ pub fn run(a: &TablesArgs) -> Result<(), String> {
             images: a.images.as_deref(),
             tile: 16,
         };
-        let mut trees = Vec::new();
+        let mut built = Vec::new();
         for (name, scene, ..) in scenes.iter().filter(|s| s.5) {
             eprintln!("measuring shading on {name} ({} triangles)", scene.triangle_count());
-            trees.push(build_tree(scene, &params, a.threads as usize)?);
+            built.push(build_structures(
+                scene,
+                &[Method::Mft],
+                Purpose::Frames,
+                &structure_params,
+                a.threads as usize,
+            )?);
         }
         let subjects: Vec<Subject> = scenes
             .iter()
             .filter(|s| s.5)
-            .zip(&trees)
-            .map(|((name, scene, camera, light, ..), tree)| Subject {
+            .zip(&built)
+            .map(|((name, scene, camera, light, ..), structures)| Subject {
                 name,
                 scene,
-                tree,
+                structures,
                 camera: *camera,
                 light: *light,
             })

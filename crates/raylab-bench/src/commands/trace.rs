@@ -3,14 +3,15 @@
 use clap::Args;
 use raylab_core::dacrt::Dacrt;
 use raylab_core::mbvh::Mbvh;
-use raylab_core::reference::BruteForce;
+use raylab_core::method::Structure;
+use raylab_core::structures::Structures;
 use raylab_core::trace::Tracer;
 use raylab_core::workload::{RayKind, WorkloadBuilder};
 use serde_json::json;
 
 use crate::args::{ImageArgs, KdArgs, MethodArgs, SceneArgs, in_range, parse_group};
 use crate::env::Environment;
-use crate::prepare::{build_tree, load_scene, with_spinner};
+use crate::prepare::{load_scene, with_spinner};
 use crate::timing::{measure, tile_for_group, validate};
 
 /// Traces the Embree harness's rays and reports Mrays/s, checksums and counters.
@@ -56,11 +57,20 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     let env = Environment::detect();
     let (scene, _) = load_scene(&a.scene.source())?;
     let (camera, light) = a.scene.camera_and_light(&scene)?;
-    let tree = build_tree(&scene, &a.kd.params_for(a.m.method)?, a.threads as usize)?;
-    let reference = BruteForce::new(&scene);
+    // The method's structure, the thesis's kd-tree that traces the harness's primary pass (the hit points the
+    // shadow and diffuse rays leave from), and the brute force the results are validated against.
+    let params = a.kd.structure_params()?;
+    let needs = [a.m.method.kernel_structure(), Structure::ThesisKd, Structure::Reference];
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string())?;
+    let structures =
+        with_spinner("building structures", || pool.install(|| Structures::build_these(&scene, &needs, &params)))
+            .map_err(|e| e.to_string())?;
+    let (Some(tree), Some(reference)) = (structures.kd(Structure::ThesisKd), structures.reference()) else {
+        unreachable!("built above");
+    };
     let (w, h) = a.image.size();
     let builder = with_spinner("generating rays", || {
-        WorkloadBuilder::new(&scene, &camera, light.position, w, h, &tree).seed(a.seed)
+        WorkloadBuilder::new(&scene, &camera, light.position, w, h, tree).seed(a.seed)
     });
     let workload = builder.build(a.kind);
     let mut options = a.m.options();
@@ -72,33 +82,16 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         options.stream_group = Some(g as usize);
         tile = tile_for_group(tile as u32, g as u32) as u64;
     }
-    let mbvh = options.method.uses_mbvh().then(|| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string());
-        pool.map(|p| with_spinner("building MBVH", || p.install(|| Mbvh::build(&scene))))
-    });
-    // The structures take the backend asked for, like the kd-tree kernels.
-    let mbvh = mbvh.transpose()?.map(|mut m| {
-        m.backend = options.backend;
-        m
-    });
-    let dacrt = options.method.uses_dacrt().then(|| {
-        let mut d = Dacrt::new(&scene);
-        d.backend = options.backend;
-        d
-    });
-    let mut tracer = Tracer::new(&tree, Some(&reference), options);
-    if let Some(m) = &mbvh {
-        tracer = tracer.with_mbvh(m);
-    }
-    if let Some(d) = &dacrt {
-        tracer = tracer.with_dacrt(d);
-    }
+    let tracer = Tracer::for_rays(&structures, options).map_err(|e| e.to_string())?;
+    let mbvh = structures.mbvh();
     let setup = || drop(Dacrt::new(&scene));
-    let setup = dacrt.as_ref().map(|_| &setup as &(dyn Fn() + Sync));
+    let setup = structures.dacrt().map(|_| &setup as &(dyn Fn() + Sync));
     let runs = (a.threads as usize, a.warmup as usize, a.reps as usize);
     let (report, results) = measure(&tracer, &workload, tile as u32, runs, setup)?;
+    // The kd-tree the report describes: the method's own, else the one that traced the primary pass.
+    let kd = structures.kd_for(options.method).unwrap_or(tree);
     let checked = with_spinner("validating against brute force", || {
-        validate(&reference, &workload, &results, a.validate as usize)
+        validate(reference, &workload, &results, a.validate as usize)
     })
     .map_err(|m| format!("validation failed ({} vs brute force): {m}", a.m.method))?;
     if a.json {
@@ -115,10 +108,11 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
             "group": a.group,
             "cull": options.cull,
             "backend": options.backend.name(),
-            "kd_build_seconds": tree.build_time().as_secs_f64(),
-            "kd_params": tree.params(),
-            "kd_nodes": tree.nodes().len(),
-            "mbvh": mbvh.as_ref().map(Mbvh::stats),
+            "kd_build_seconds": kd.build_time().as_secs_f64(),
+            "kd_params": kd.params(),
+            "kd_nodes": kd.nodes().len(),
+            "mbvh": mbvh.map(Mbvh::stats),
+            "structures": structures.builds(),
             "validated_rays": checked,
             "result": report,
         });
@@ -127,16 +121,15 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     }
     println!("environment      {}", env.line());
     println!("scene            {} ({} triangles), {}x{}", a.scene.scene, scene.triangle_count(), w, h);
-    let kd = tree.params();
     println!(
         "kd-tree          C_trav {}, C_isect {}: {} nodes, built in {:.3} s on {} thread(s)",
-        kd.c_trav,
-        kd.c_isect,
-        tree.nodes().len(),
-        tree.build_time().as_secs_f64(),
+        kd.params().c_trav,
+        kd.params().c_isect,
+        kd.nodes().len(),
+        kd.build_time().as_secs_f64(),
         a.threads
     );
-    if let Some(m) = &mbvh {
+    if let Some(m) = mbvh {
         let st = m.stats();
         println!(
             "MBVH             built in {:.3} s on {} thread(s): {} nodes ({:.0}% of lanes used), {} leaves, depth {}, \

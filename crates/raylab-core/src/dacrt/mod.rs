@@ -132,8 +132,6 @@ pub struct Dacrt {
     setup_time: Duration,
     /// Working memory of finished calls, reused by the next ones (one per thread that traced).
     pool: Mutex<Vec<Scratch>>,
-    /// SIMD backend of the ray filter.
-    pub backend: Backend,
 }
 
 impl Dacrt {
@@ -146,15 +144,7 @@ impl Dacrt {
             soup.as_slice().iter().enumerate().map(|(i, t)| TriRecord::new(*t, i as u32)).collect();
         let root = SetBounds::of(&refs);
         let top = divide_top(&mut refs, &root);
-        Self {
-            soup,
-            refs,
-            root,
-            top,
-            setup_time: start.elapsed(),
-            pool: Mutex::new(Vec::new()),
-            backend: Backend::detect(),
-        }
+        Self { soup, refs, root, top, setup_time: start.elapsed(), pool: Mutex::new(Vec::new()) }
     }
 
     /// How long [`Dacrt::new`] took.
@@ -168,16 +158,24 @@ impl Dacrt {
         self.top.len()
     }
 
+    /// Bytes of the triangle copy, their records and the setup's division.
+    pub fn bytes(&self) -> usize {
+        self.soup.len() * std::mem::size_of::<[glam::Vec3; 3]>()
+            + self.refs.len() * std::mem::size_of::<TriRecord>()
+            + self.top.len() * std::mem::size_of::<TopNode>()
+    }
+
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.refs.len()
     }
 
     /// Closest hits in `(tmin, tmax]` of all `rays` (`None` entries are skipped), written to `out`; among hits
-    /// at one distance the lowest triangle id wins.
+    /// at one distance the lowest triangle id wins. The filter and the leaves run in `backend`'s lanes.
     pub fn intersect(
         &self,
         p: &DacrtParams,
+        backend: Backend,
         rays: &[Option<Ray>],
         out: &mut [Option<Hit>],
         stats: &mut TraversalStats,
@@ -185,10 +183,10 @@ impl Dacrt {
         assert_eq!(rays.len(), out.len());
         out.fill(None);
         let Some(groups) = self.fork(rays.len()) else {
-            return self.run(p, rays, self.whole(), Closest { out }, stats);
+            return self.run(p, backend, rays, self.whole(), Closest { out }, stats);
         };
         let mut second = vec![None; rays.len()];
-        self.run_forked(p, rays, groups, [Closest { out: &mut *out }, Closest { out: &mut second }], stats);
+        self.run_forked(p, backend, rays, groups, [Closest { out: &mut *out }, Closest { out: &mut second }], stats);
         for (o, s) in out.iter_mut().zip(second) {
             if let Some(s) = s
                 && s.beats(*o)
@@ -199,14 +197,21 @@ impl Dacrt {
     }
 
     /// Whether anything blocks each of `rays` in `(tmin, tmax]`, written to `out`.
-    pub fn occluded(&self, p: &DacrtParams, rays: &[Option<Ray>], out: &mut [bool], stats: &mut TraversalStats) {
+    pub fn occluded(
+        &self,
+        p: &DacrtParams,
+        backend: Backend,
+        rays: &[Option<Ray>],
+        out: &mut [bool],
+        stats: &mut TraversalStats,
+    ) {
         assert_eq!(rays.len(), out.len());
         out.fill(false);
         let Some(groups) = self.fork(rays.len()) else {
-            return self.run(p, rays, self.whole(), Any { out }, stats);
+            return self.run(p, backend, rays, self.whole(), Any { out }, stats);
         };
         let mut second = vec![false; rays.len()];
-        self.run_forked(p, rays, groups, [Any { out: &mut *out }, Any { out: &mut second }], stats);
+        self.run_forked(p, backend, rays, groups, [Any { out: &mut *out }, Any { out: &mut second }], stats);
         for (o, s) in out.iter_mut().zip(second) {
             *o |= s;
         }
@@ -216,6 +221,7 @@ impl Dacrt {
     pub fn occluders(
         &self,
         p: &DacrtParams,
+        backend: Backend,
         rays: &[Option<Ray>],
         out: &mut [Option<u32>],
         stats: &mut TraversalStats,
@@ -223,10 +229,10 @@ impl Dacrt {
         assert_eq!(rays.len(), out.len());
         out.fill(None);
         let Some(groups) = self.fork(rays.len()) else {
-            return self.run(p, rays, self.whole(), Blocker { out }, stats);
+            return self.run(p, backend, rays, self.whole(), Blocker { out }, stats);
         };
         let mut second = vec![None; rays.len()];
-        self.run_forked(p, rays, groups, [Blocker { out: &mut *out }, Blocker { out: &mut second }], stats);
+        self.run_forked(p, backend, rays, groups, [Blocker { out: &mut *out }, Blocker { out: &mut second }], stats);
         for (o, s) in out.iter_mut().zip(second) {
             *o = o.or(s);
         }
@@ -260,6 +266,7 @@ impl Dacrt {
     fn run_forked<A: Answer + Send>(
         &self,
         p: &DacrtParams,
+        backend: Backend,
         rays: &[Option<Ray>],
         groups: [Group; 2],
         [first, second]: [A; 2],
@@ -267,8 +274,8 @@ impl Dacrt {
     ) {
         let (mut a, mut b) = (TraversalStats::default(), TraversalStats::default());
         rayon::join(
-            || self.run(p, rays, groups[0].clone(), first, &mut a),
-            || self.run(p, rays, groups[1].clone(), second, &mut b),
+            || self.run(p, backend, rays, groups[0].clone(), first, &mut a),
+            || self.run(p, backend, rays, groups[1].clone(), second, &mut b),
         );
         // Each ray was counted by both groups.
         b.rays = 0;
@@ -281,6 +288,7 @@ impl Dacrt {
     fn run<A: Answer>(
         &self,
         p: &DacrtParams,
+        backend: Backend,
         rays: &[Option<Ray>],
         group: Group,
         answer: A,
@@ -307,7 +315,7 @@ impl Dacrt {
                 params: *p,
                 answer,
                 flags: std::mem::take(&mut scratch.flags),
-                backend: self.backend,
+                backend,
                 stats: TraversalStats::default(),
             };
             let Scratch { tris, rays, .. } = &mut scratch;
@@ -336,6 +344,6 @@ impl Dacrt {
 
 impl std::fmt::Debug for Dacrt {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Dacrt").field("triangles", &self.refs.len()).field("backend", &self.backend).finish()
+        f.debug_struct("Dacrt").field("triangles", &self.refs.len()).finish()
     }
 }

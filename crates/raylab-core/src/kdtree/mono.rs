@@ -10,6 +10,7 @@
 
 use std::ops::Range;
 
+use crate::intersector::Intersector;
 use crate::ray::{Hit, Ray, hit_reach};
 use crate::stats::TraversalStats;
 use crate::triangle::RayShear;
@@ -174,5 +175,14 @@ impl KdTree {
         }
         stats.nodes += visited;
         stats.leaves += leaves;
+    }
+}
+
+impl Intersector for KdTree {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        KdTree::intersect(self, ray, stats)
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        KdTree::occluded(self, ray, stats)
     }
 }

@@ -2,8 +2,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::method::Method;
-
 /// How a node's split plane is chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum SplitStrategy {
@@ -67,13 +65,6 @@ impl KdParams {
     /// of the thesis's tree), and packets gain 1.05-1.15x on primary, shadow and diffuse rays
     /// (docs/BENCHMARKS.md); single rays move within the noise, so they keep the thesis's model.
     pub const PACKET_C_TRAV: f32 = 12.0;
-
-    /// The cost model for a tree that `method` walks: [`KdParams::PACKET_C_TRAV`] for the packet methods
-    /// ([`Method::uses_packets`]), the thesis's (the default) for every other.
-    pub fn for_method(method: Method) -> Self {
-        let c_trav = if method.uses_packets() { Self::PACKET_C_TRAV } else { Self::default().c_trav };
-        Self { c_trav, ..Self::default() }
-    }
 
     /// The depth limit used for a scene of `n` triangles.
     pub fn depth_for(&self, n: usize) -> u32 {

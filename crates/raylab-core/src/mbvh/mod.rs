@@ -15,7 +15,6 @@ pub use stream::{StreamLeaves, StreamOptions};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raylab_simd::Backend;
 use serde::Serialize;
 
 use crate::aabb::Aabb;
@@ -42,8 +41,6 @@ pub struct Mbvh {
     references: usize,
     /// Levels of 4-wide nodes (the root is 1), which sizes the traversal stack.
     depth: usize,
-    /// SIMD backend of the box tests.
-    pub backend: Backend,
 }
 
 /// How the MBVH build uses spatial splits (see the build module: SAH binning with the SBVH's spatial splits).
@@ -118,7 +115,6 @@ impl Mbvh {
             binary_nodes: built.binary_nodes,
             references: built.references,
             depth,
-            backend: Backend::detect(),
         }
     }
 

@@ -10,7 +10,7 @@
 
 use std::ops::Range;
 
-use raylab_simd::{Kernel, VMask, Vf32};
+use raylab_simd::{Backend, Kernel, VMask, Vf32};
 
 use super::Mbvh;
 use super::node::MbvhNode;
@@ -178,24 +178,24 @@ impl<Q: Query> Kernel for SingleRay<'_, Q> {
 }
 
 impl Mbvh {
-    /// The closest hit along `ray` in `(tmin, tmax]`.
-    pub fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        self.single_ray::<ClosestHit>(ray, stats)
+    /// The closest hit along `ray` in `(tmin, tmax]`, with the box tests in `backend`'s lanes.
+    pub fn intersect(&self, ray: &Ray, backend: Backend, stats: &mut TraversalStats) -> Option<Hit> {
+        self.single_ray::<ClosestHit>(ray, backend, stats)
     }
 
     /// True when anything blocks `ray` in `(tmin, tmax]`.
-    pub fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
-        self.occluder(ray, stats).is_some()
+    pub fn occluded(&self, ray: &Ray, backend: Backend, stats: &mut TraversalStats) -> bool {
+        self.occluder(ray, backend, stats).is_some()
     }
 
     /// The first blocker found along `ray` (not necessarily the nearest), for the shadow cache.
-    pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
-        self.single_ray::<FirstBlocker>(ray, stats)
+    pub fn occluder(&self, ray: &Ray, backend: Backend, stats: &mut TraversalStats) -> Option<u32> {
+        self.single_ray::<FirstBlocker>(ray, backend, stats)
     }
 
-    fn single_ray<Q: Query>(&self, ray: &Ray, stats: &mut TraversalStats) -> Q::Output {
+    fn single_ray<Q: Query>(&self, ray: &Ray, backend: Backend, stats: &mut TraversalStats) -> Q::Output {
         let kernel = SingleRay::<Q> { mbvh: self, ray, stats, query: std::marker::PhantomData };
-        raylab_simd::dispatch(self.backend.at_most_eight_lanes(), kernel)
+        raylab_simd::dispatch(backend.at_most_eight_lanes(), kernel)
     }
 
     /// [`tri4::closest_in_leaf`] on this tree's blocks.

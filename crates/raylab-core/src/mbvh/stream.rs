@@ -27,7 +27,7 @@
 
 use std::ops::Range;
 
-use raylab_simd::{Kernel, VMask, Vf32};
+use raylab_simd::{Backend, Kernel, VMask, Vf32};
 use serde::{Deserialize, Serialize};
 
 use super::Mbvh;
@@ -240,17 +240,18 @@ impl Slot {
 }
 
 impl Mbvh {
-    /// Closest hits of a group of rays traced together (`None` rays are skipped).
+    /// Closest hits of a group of rays traced together (`None` rays are skipped), in `backend`'s lanes.
     pub fn intersect_stream(
         &self,
         rays: &[Option<Ray>],
         out: &mut [Option<Hit>],
         options: StreamOptions,
+        backend: Backend,
         stats: &mut TraversalStats,
     ) {
         let emit = |i: usize, _: &Hot, s: &Slot| out[i] = s.hit;
         raylab_simd::dispatch(
-            self.backend.at_most_eight_lanes(),
+            backend.at_most_eight_lanes(),
             Stream { mbvh: self, rays, shadow: false, options, stats, emit },
         );
     }
@@ -261,11 +262,12 @@ impl Mbvh {
         rays: &[Option<Ray>],
         out: &mut [bool],
         options: StreamOptions,
+        backend: Backend,
         stats: &mut TraversalStats,
     ) {
         let emit = |i: usize, h: &Hot, _: &Slot| out[i] = h.blocked();
         raylab_simd::dispatch(
-            self.backend.at_most_eight_lanes(),
+            backend.at_most_eight_lanes(),
             Stream { mbvh: self, rays, shadow: true, options, stats, emit },
         );
     }

@@ -20,17 +20,19 @@ use raylab_simd::{Backend, VMask, Vf32};
 use serde::Serialize;
 
 use crate::dacrt::{Dacrt, DacrtParams};
+use crate::intersector::Intersector;
 use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
 use crate::kdtree::packet::PacketStack;
 use crate::mbvh::{Mbvh, StreamLeaves, StreamOptions};
-use crate::method::{Intersector, Method};
+use crate::method::{Method, Purpose};
 use crate::packet::PacketTile;
 use crate::ray::{Hit, Ray};
 use crate::reference::BruteForce;
 use crate::render::RayOrder;
 use crate::shadow::EdgeWidth;
 use crate::stats::TraversalStats;
+use crate::structures::{MissingStructure, Structures};
 use bundle::{Bundled, RayRect, common_origin, cone_from, frustum_from, toward_cone, toward_frustum};
 use kernels::{EdgeWidthsSimd, IntersectSimd, OccludedSimd};
 
@@ -86,9 +88,12 @@ impl Default for TraceOptions {
     }
 }
 
-/// Traces tiles of rays through a kd-tree (or brute force, for [`Method::Reference`]).
+/// Traces tiles of rays with one method through the [`Structures`] it was made from.
+#[derive(Clone, Copy)]
 pub struct Tracer<'a> {
-    tree: &'a KdTree,
+    /// The kd-tree the method walks ([`Method::frame_kd`]); `None` only for the reference and for a
+    /// [`Tracer::for_rays`] of a method whose kernel is another structure.
+    tree: Option<&'a KdTree>,
     reference: Option<&'a BruteForce>,
     mbvh: Option<&'a Mbvh>,
     dacrt: Option<&'a Dacrt>,
@@ -97,56 +102,65 @@ pub struct Tracer<'a> {
 }
 
 impl<'a> Tracer<'a> {
-    /// A tracer over `tree`; `reference` is needed only for [`Method::Reference`].
-    pub fn new(tree: &'a KdTree, reference: Option<&'a BruteForce>, options: TraceOptions) -> Self {
-        Self { tree, reference, mbvh: None, dacrt: None, options }
+    /// A tracer of `options.method` for whole frames: refused when `structures` lack the method's kernel
+    /// structure or the kd-tree its frames walk ([`Method::structures`] with [`Purpose::Frames`]).
+    pub fn new(structures: &'a Structures, options: TraceOptions) -> Result<Self, MissingStructure> {
+        structures.check(options.method, Purpose::Frames)?;
+        Ok(Self::from_structures(structures, options))
     }
 
-    /// The same tracer with an MBVH over the same scene, needed for [`Method::Mbvh`].
-    pub fn with_mbvh(self, mbvh: &'a Mbvh) -> Self {
-        Self { mbvh: Some(mbvh), ..self }
+    /// A tracer of `options.method` for tiles of rays only ([`Tracer::intersect_tile`],
+    /// [`Tracer::occluded_tile`], [`Tracer::occluders_tile`]): needs only the method's kernel structure.
+    /// Frames' edge-width and sampled-shadow walks need a tracer made with [`Tracer::new`].
+    pub fn for_rays(structures: &'a Structures, options: TraceOptions) -> Result<Self, MissingStructure> {
+        structures.check(options.method, Purpose::Rays)?;
+        Ok(Self::from_structures(structures, options))
     }
 
-    /// The same tracer with the scene prepared for divide-and-conquer tracing, needed for [`Method::Dacrt`].
-    pub fn with_dacrt(self, dacrt: &'a Dacrt) -> Self {
-        Self { dacrt: Some(dacrt), ..self }
+    fn from_structures(s: &'a Structures, options: TraceOptions) -> Self {
+        Self { tree: s.kd_for(options.method), reference: s.reference(), mbvh: s.mbvh(), dacrt: s.dacrt(), options }
+    }
+
+    /// The kd-tree the method walks. Present for every method but the reference when the tracer was made with
+    /// [`Tracer::new`]; the reference never asks for it.
+    fn tree(&self) -> &'a KdTree {
+        self.tree.expect("a kd-tree walk needs a tracer made with Tracer::new (Purpose::Frames)")
     }
 
     fn dacrt(&self) -> &'a Dacrt {
-        self.dacrt.expect("the dacrt method needs a Dacrt (Tracer::with_dacrt)")
+        self.dacrt.expect("checked by Structures::check: the dacrt method has its preparation")
     }
 
     fn mbvh(&self) -> &'a Mbvh {
-        self.mbvh.expect("the mbvh method needs an Mbvh (Tracer::with_mbvh)")
+        self.mbvh.expect("checked by Structures::check: the mbvh methods have their MBVH")
+    }
+
+    fn reference(&self) -> &'a BruteForce {
+        self.reference.expect("checked by Structures::check: the reference method has its brute force")
     }
 
     fn stream_options(&self) -> StreamOptions {
         StreamOptions { ordered: self.options.stream_order, leaves: self.options.stream_leaves }
     }
 
-    /// The same tracer with another traversal method (the brute-force reference stays the reference).
+    /// The same tracer with another traversal method over the same kd-tree (the brute-force reference stays
+    /// the reference): sampled shadows trace their bundles with the packet or frustum kernels.
     pub fn with_method(&self, method: Method) -> Tracer<'a> {
         let method = if self.options.method == Method::Reference { Method::Reference } else { method };
-        Tracer {
-            tree: self.tree,
-            reference: self.reference,
-            mbvh: self.mbvh,
-            dacrt: self.dacrt,
-            options: TraceOptions { method, ..self.options },
-        }
+        Tracer { options: TraceOptions { method, ..self.options }, ..*self }
     }
 
     /// The first blocker found along a single ray (for the shadow cache).
     pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
         match self.options.method {
             Method::Reference => self.reference().occluder(ray, stats),
-            Method::Mbvh | Method::MbvhRs => self.mbvh().occluder(ray, stats),
+            Method::Mbvh | Method::MbvhRs => self.mbvh().occluder(ray, self.options.backend, stats),
             Method::Dacrt => {
                 let mut out = [None];
-                self.dacrt().occluders(&self.options.dacrt, &[Some(*ray)], &mut out, stats);
+                self.dacrt().occluders(&self.options.dacrt, self.options.backend, &[Some(*ray)], &mut out, stats);
                 out[0]
             }
-            _ => self.tree.occluder(ray, stats),
+            _ => self.tree().occluder(ray, stats),
         }
     }
 
@@ -155,7 +169,7 @@ impl<'a> Tracer<'a> {
     pub fn occluders_tile(&self, rays: &[Option<Ray>], out: &mut [Option<u32>], stats: &mut TraversalStats) {
         assert_eq!(rays.len(), out.len());
         if self.options.method == Method::Dacrt {
-            self.dacrt().occluders(&self.options.dacrt, rays, out, stats);
+            self.dacrt().occluders(&self.options.dacrt, self.options.backend, rays, out, stats);
             return;
         }
         for (o, r) in out.iter_mut().zip(rays) {
@@ -169,7 +183,7 @@ impl<'a> Tracer<'a> {
             Method::Reference => self.reference().blocks(ray, tri),
             Method::Dacrt => self.dacrt().blocks(ray, tri),
             Method::Mbvh | Method::MbvhRs => self.mbvh().blocks(ray, tri),
-            _ => self.tree.blocks(ray, tri),
+            _ => self.tree().blocks(ray, tri),
         }
     }
 
@@ -179,7 +193,7 @@ impl<'a> Tracer<'a> {
     pub fn edge_width(&self, ray: &Ray, state: &mut EdgeWidth, stats: &mut TraversalStats) -> f32 {
         match self.options.method {
             Method::Reference => self.reference().edge_width(ray, state, stats),
-            _ => self.tree.edge_width(ray, state, stats),
+            _ => self.tree().edge_width(ray, state, stats),
         }
     }
 
@@ -247,19 +261,15 @@ impl<'a> Tracer<'a> {
             // `if let` rather than `Option::map` closures, whose vector code may stay out of line (see `map3`).
             if matches!(method, Method::Cone | Method::MftCone) {
                 if let Some(c) = toward_cone(&whole, toward, limit) {
-                    self.tree.edge_widths_bundle(&c, tile, cull, states, out, stats);
+                    self.tree().edge_widths_bundle(&c, tile, cull, states, out, stats);
                     return;
                 }
             } else if let Some(f) = toward_frustum(&whole, toward, limit) {
-                self.tree.edge_widths_bundle(&f, tile, cull, states, out, stats);
+                self.tree().edge_widths_bundle(&f, tile, cull, states, out, stats);
                 return;
             }
         }
-        self.tree.edge_widths::<V>(rays, states, out, stack, stats);
-    }
-
-    fn reference(&self) -> &'a BruteForce {
-        self.reference.expect("the reference method needs a BruteForce")
+        self.tree().edge_widths::<V>(rays, states, out, stack, stats);
     }
 
     /// Closest hits of a `width x height` tile of rays (row-major; `None` where no ray is traced).
@@ -273,13 +283,18 @@ impl<'a> Tracer<'a> {
     ) {
         assert!(rays.len() == width * height && out.len() == rays.len());
         match self.options.method {
-            Method::Mono => closest_each(self.tree, rays, out, stats),
+            Method::Mono => closest_each(self.tree(), rays, out, stats),
             Method::Reference => closest_each(self.reference(), rays, out, stats),
-            Method::Mbvh => closest_each(self.mbvh(), rays, out, stats),
+            Method::Mbvh => {
+                let (mbvh, backend) = (self.mbvh(), self.options.backend);
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = r.and_then(|r| mbvh.intersect(&r, backend, stats));
+                }
+            }
             Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
-                self.mbvh().intersect_stream(r, o, self.stream_options(), stats)
+                self.mbvh().intersect_stream(r, o, self.stream_options(), self.options.backend, stats)
             }),
-            Method::Dacrt => self.dacrt().intersect(&self.options.dacrt, rays, out, stats),
+            Method::Dacrt => self.dacrt().intersect(&self.options.dacrt, self.options.backend, rays, out, stats),
             _ => raylab_simd::dispatch(
                 self.options.backend,
                 IntersectSimd { tracer: self, rays, width, height, out, stats },
@@ -299,13 +314,18 @@ impl<'a> Tracer<'a> {
     ) {
         assert!(rays.len() == width * height && out.len() == rays.len());
         match self.options.method {
-            Method::Mono => occluded_each(self.tree, rays, out, stats),
+            Method::Mono => occluded_each(self.tree(), rays, out, stats),
             Method::Reference => occluded_each(self.reference(), rays, out, stats),
-            Method::Mbvh => occluded_each(self.mbvh(), rays, out, stats),
+            Method::Mbvh => {
+                let (mbvh, backend) = (self.mbvh(), self.options.backend);
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = r.is_some_and(|r| mbvh.occluded(&r, backend, stats));
+                }
+            }
             Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
-                self.mbvh().occluded_stream(r, o, self.stream_options(), stats)
+                self.mbvh().occluded_stream(r, o, self.stream_options(), self.options.backend, stats)
             }),
-            Method::Dacrt => self.dacrt().occluded(&self.options.dacrt, rays, out, stats),
+            Method::Dacrt => self.dacrt().occluded(&self.options.dacrt, self.options.backend, rays, out, stats),
             _ => raylab_simd::dispatch(
                 self.options.backend,
                 OccludedSimd { tracer: self, rays, width, height, toward, out, stats },
@@ -373,14 +393,14 @@ impl<'a> Tracer<'a> {
             (Method::Frustum, Some(o)) => {
                 let f = frustum_from(o, tile, all.clone());
                 if let Some(f) = &f {
-                    self.tree.intersect_frustum(f, tile, all, cull, stats);
+                    self.tree().intersect_frustum(f, tile, all, cull, stats);
                 }
                 f.is_some()
             }
             (Method::Cone, Some(o)) => {
                 let c = cone_from(o, tile, all.clone());
                 if let Some(c) = &c {
-                    self.tree.intersect_frustum(c, tile, all, cull, stats);
+                    self.tree().intersect_frustum(c, tile, all, cull, stats);
                 }
                 c.is_some()
             }
@@ -388,7 +408,7 @@ impl<'a> Tracer<'a> {
                 if let Some((b, sets, _)) = self.quadrants(tile, rays, None, shared, frustum_from, toward_frustum)
                     && let Some(f4) = Frustum4::new(b)
                 {
-                    self.tree.intersect_mft(&f4, tile, &sets, cull, stats);
+                    self.tree().intersect_mft(&f4, tile, &sets, cull, stats);
                     true
                 } else {
                     false
@@ -398,7 +418,7 @@ impl<'a> Tracer<'a> {
                 if let Some((b, sets, _)) = self.quadrants(tile, rays, None, shared, cone_from, toward_cone)
                     && let Some(c4) = Frustum4::new(b)
                 {
-                    self.tree.intersect_mft(&c4, tile, &sets, cull, stats);
+                    self.tree().intersect_mft(&c4, tile, &sets, cull, stats);
                     true
                 } else {
                     false
@@ -422,8 +442,9 @@ impl<'a> Tracer<'a> {
         stack: &mut PacketStack<V>,
         stats: &mut TraversalStats,
     ) {
+        let tree = self.tree();
         for (p, h) in tile.packets.iter().zip(tile.hits.iter_mut()) {
-            self.tree.intersect_packet(p, h, stack, stats);
+            tree.intersect_packet(p, h, stack, stats);
         }
     }
 
@@ -465,18 +486,18 @@ impl<'a> Tracer<'a> {
         match self.options.method {
             Method::Frustum => {
                 match self.whole(tile, all.clone(), rays, toward, shared, frustum_from, toward_frustum) {
-                    Some(f) => self.tree.occluded_frustum(&f, tile, all, cull, far_first(f.origin), blocked, stats),
+                    Some(f) => self.tree().occluded_frustum(&f, tile, all, cull, far_first(f.origin), blocked, stats),
                     None => rest[0] = all,
                 }
             }
             Method::Cone => match self.whole(tile, all.clone(), rays, toward, shared, cone_from, toward_cone) {
-                Some(c) => self.tree.occluded_frustum(&c, tile, all, cull, far_first(c.bound.origin), blocked, stats),
+                Some(c) => self.tree().occluded_frustum(&c, tile, all, cull, far_first(c.bound.origin), blocked, stats),
                 None => rest[0] = all,
             },
             Method::Mft => match self.quadrants(tile, rays, toward, shared, frustum_from, toward_frustum) {
                 Some((b, sets, left)) => {
                     if let Some(f4) = Frustum4::new(b) {
-                        self.tree.occluded_mft(&f4, tile, &sets, cull, far_first(f4.origin()), blocked, stats);
+                        self.tree().occluded_mft(&f4, tile, &sets, cull, far_first(f4.origin()), blocked, stats);
                     }
                     rest = left;
                 }
@@ -485,7 +506,7 @@ impl<'a> Tracer<'a> {
             Method::MftCone => match self.quadrants(tile, rays, toward, shared, cone_from, toward_cone) {
                 Some((b, sets, left)) => {
                     if let Some(c4) = Frustum4::new(b) {
-                        self.tree.occluded_mft(&c4, tile, &sets, cull, far_first(c4.origin()), blocked, stats);
+                        self.tree().occluded_mft(&c4, tile, &sets, cull, far_first(c4.origin()), blocked, stats);
                     }
                     rest = left;
                 }
@@ -493,8 +514,9 @@ impl<'a> Tracer<'a> {
             },
             _ => rest[0] = all,
         }
+        let tree = self.tree();
         for j in rest.into_iter().flatten() {
-            blocked[j] = self.tree.occluded_packet(&tile.packets[j], stack, stats);
+            blocked[j] = tree.occluded_packet(&tile.packets[j], stack, stats);
         }
         for (j, b) in blocked.iter().enumerate() {
             let bits = b.bits();
@@ -524,3 +546,17 @@ fn occluded_each<I: Intersector>(i: &I, rays: &[Option<Ray>], out: &mut [bool], 
 /// whose tiles hold fewer and less coherent segments, walking every tile as a bundle was 1.02-1.04x slower
 /// (both measured when only the blocked segments walked, in row order).
 const EDGE_BUNDLE_MIN_RAYS: usize = 128;
+
+/// Single rays through the tracer's method, each as a tile of one (the method's kernels, backend and options).
+impl Intersector for Tracer<'_> {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        let mut out = [None];
+        self.intersect_tile(&[Some(*ray)], 1, 1, &mut out, stats);
+        out[0]
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        let mut out = [false];
+        self.occluded_tile(&[Some(*ray)], 1, 1, None, &mut out, stats);
+        out[0]
+    }
+}

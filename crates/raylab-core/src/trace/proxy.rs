@@ -106,7 +106,7 @@ impl Tracer<'_> {
         let all = 0..tile.packets.len();
         blocked.clear();
         blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
-        let (tree, cull) = (self.tree, self.options.cull);
+        let (tree, cull) = (self.tree(), self.options.cull);
         // The rays start at the apex, by the blockers near their surface point: nearest leaves first.
         match proxy {
             Proxy::Pyramid(f) => tree.occluded_frustum(f, tile, all, cull, false, blocked, stats),

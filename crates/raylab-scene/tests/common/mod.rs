@@ -3,14 +3,50 @@
 #![allow(dead_code)]
 
 use glam::{Affine3A, Vec3};
+use raylab_core::dacrt::{Dacrt, DacrtParams};
+use raylab_core::intersector::Intersector;
 use raylab_core::kdtree::KdTree;
-use raylab_core::method::Intersector;
-use raylab_core::ray::Ray;
+use raylab_core::mbvh::Mbvh;
+use raylab_core::method::{Method, Purpose};
+use raylab_core::ray::{Hit, Ray};
 use raylab_core::reference::BruteForce;
 use raylab_core::scene::Scene;
 use raylab_core::stats::TraversalStats;
+use raylab_core::structures::{StructureParams, Structures};
 use raylab_scene::MeshBuilder;
 use raylab_scene::mesh::Jitter;
+use raylab_simd::Backend;
+
+/// A structure's own single-ray queries, in the lanes of one SIMD backend.
+pub struct Lanes<'a, S>(pub &'a S, pub Backend);
+
+impl Intersector for Lanes<'_, Mbvh> {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        self.0.intersect(ray, self.1, stats)
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        self.0.occluded(ray, self.1, stats)
+    }
+}
+
+/// One ray as a set of one, with the default parameters.
+impl Intersector for Lanes<'_, Dacrt> {
+    fn intersect(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        let mut out = [None];
+        self.0.intersect(&DacrtParams::default(), self.1, &[Some(*ray)], &mut out, stats);
+        out[0]
+    }
+    fn occluded(&self, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        let mut out = [false];
+        self.0.occluded(&DacrtParams::default(), self.1, &[Some(*ray)], &mut out, stats);
+        out[0]
+    }
+}
+
+/// The structures `methods` need for frames, with the default parameters.
+pub fn structures(scene: &Scene, methods: &[Method]) -> Structures {
+    Structures::build(scene, methods, Purpose::Frames, &StructureParams::default()).unwrap()
+}
 
 /// Asserts that `method` returns the same closest hit (triangle and t, bit for bit) and the same occlusion
 /// as brute force for every ray. Where two triangles are hit at the same distance (a shared edge, coincident

@@ -180,10 +180,11 @@ impl HybridGpu {
 
 #[cfg(test)]
 mod tests {
-    use raylab_core::kdtree::{KdParams, KdTree};
+    use raylab_core::method::{Method, Purpose};
     use raylab_core::render::RenderSettings;
     use raylab_core::render::hybrid::{psnr, reference_reflections, reflection_ray, shade_reflections};
     use raylab_core::render::surface_epsilon;
+    use raylab_core::structures::{StructureParams, Structures};
     use raylab_core::trace::{TraceOptions, Tracer};
     use raylab_scene::builtin::{self, Detail};
 
@@ -198,8 +199,9 @@ mod tests {
         let gpu = Gpu::new(&Gpu::instance(None), None).expect("a GPU adapter (lavapipe in CI)");
         super::HybridGpu::new(&gpu).expect("an adapter that renders float targets (lavapipe in CI)");
         let scene = builtin::build("atrium", Detail::Test).unwrap();
-        let tree = KdTree::build(&scene, &KdParams::default()).unwrap();
-        let tracer = Tracer::new(&tree, None, TraceOptions::default());
+        let params = StructureParams::default();
+        let structures = Structures::build(&scene, &[Method::Mono], Purpose::Frames, &params).unwrap();
+        let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();
         let cam = scene.default_view().unwrap().camera;
         let light = scene.lights[0];
         let (w, h) = (160u32, 120u32);

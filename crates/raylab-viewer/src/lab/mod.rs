@@ -12,11 +12,12 @@ use std::time::{Duration, Instant};
 
 use raylab_bench::args::SceneArgs;
 use raylab_core::scene::PointLight;
+use raylab_core::structures::StructureParams;
 
 use crate::camera_path::{CameraPath, Player, Recorder};
 use crate::fly::{FlyCamera, MoveKeys};
 use crate::fly_scale::{FLY_BUDGET, FlyScale, scale_for_budget};
-use crate::loader::{LoadPoll, LoadedScene, PendingLoad, TreeParams};
+use crate::loader::{LoadPoll, LoadedScene, PendingLoad};
 use crate::settings::{RenderMode, ViewerSettings};
 use crate::worker::{Job, ReflectionJob, Rendered, Worker, WorkerEvent};
 pub use bookmarks::Bookmarks;
@@ -49,7 +50,7 @@ pub enum Shot {
 /// The viewer's state.
 pub struct Lab {
     scene: Arc<LoadedScene>,
-    kd: TreeParams,
+    kd: StructureParams,
     /// The settings the next frame is traced with.
     pub settings: ViewerSettings,
     fly: FlyCamera,
@@ -110,7 +111,7 @@ impl Lab {
     /// A lab showing `scene`; `wake` is called from other threads when a frame or a load is ready.
     pub fn new(
         scene: LoadedScene,
-        kd: TreeParams,
+        kd: StructureParams,
         settings: ViewerSettings,
         wake: Arc<dyn Fn() + Send + Sync>,
     ) -> Self {
@@ -398,10 +399,10 @@ impl Lab {
             self.loading = None;
             match *result {
                 Ok(s) => {
-                    let kd_s = s.kd.build_s + s.packet_kd.as_ref().map_or(0.0, |b| b.build_s);
+                    let kd_s = s.structures.build_seconds();
                     self.message(
                         format!(
-                            "loaded {}: {} triangles in {:.2} s (kd-trees {:.2} s)",
+                            "loaded {}: {} triangles in {:.2} s (structures {:.2} s)",
                             s.name,
                             s.scene.triangle_count(),
                             s.load_s,
@@ -608,7 +609,7 @@ mod tests {
     use crate::settings::{DistributionControls, RenderMode};
 
     fn lab(method: Method) -> Lab {
-        let kd = TreeParams { thesis: KdParams::for_method(Method::Mono), packets: KdParams::for_method(Method::Mft) };
+        let kd = StructureParams::default();
         let scene = load_now(&SceneArgs::named("arena"), &kd, &|_| {}).unwrap();
         let settings = ViewerSettings {
             mode: RenderMode::Whitted,
@@ -715,11 +716,13 @@ mod tests {
         let mut l = lab(Method::Mft);
         l.set_window_size(40, 24);
         let s = l.scene();
-        let (thesis, packets) = (s.kd_for(Method::Mono), s.kd_for(Method::Mft));
-        assert_eq!(thesis.tree.params().c_trav, KdParams::for_method(Method::Mono).c_trav);
-        assert_eq!(packets.tree.params().c_trav, KdParams::PACKET_C_TRAV);
-        assert!(packets.stats.nodes < thesis.stats.nodes, "{} vs {} nodes", packets.stats.nodes, thesis.stats.nodes);
-        assert!(std::ptr::eq(s.kd_for(Method::MbvhRs), thesis) && std::ptr::eq(s.kd_for(Method::Packet), packets));
+        let kd = |m| s.structures.kd_for(m).unwrap();
+        let (thesis, packets) = (kd(Method::Mono), kd(Method::Mft));
+        assert_eq!(thesis.params().c_trav, KdParams::default().c_trav);
+        assert_eq!(packets.params().c_trav, KdParams::PACKET_C_TRAV);
+        let nodes = |t: &raylab_core::kdtree::KdTree| t.nodes().len();
+        assert!(nodes(packets) < nodes(thesis), "{} vs {} nodes", nodes(packets), nodes(thesis));
+        assert!(std::ptr::eq(kd(Method::MbvhRs), thesis) && std::ptr::eq(kd(Method::Packet), packets));
         let job = l.job();
         let frames: Vec<_> = [Method::Mono, Method::Packet, Method::Mft, Method::Frustum]
             .into_iter()

@@ -67,15 +67,18 @@ fn scene_section(lab: &mut Lab, ui: &mut egui::Ui) {
         });
         ui.small("or drop an .obj, .gltf or .glb file on the window");
         let s = &lab.scene;
-        let kd = s.kd_for(lab.settings.frame_method());
-        ui.label(format!(
-            "{} triangles; the method's kd-tree: {} nodes (depth {}, C_trav {}), built in {:.2} s",
-            s.scene.triangle_count(),
-            kd.stats.nodes,
-            kd.stats.max_depth,
-            kd.tree.params().c_trav,
-            kd.build_s
-        ));
+        let method = lab.settings.frame_method();
+        let built = method.frame_kd().and_then(|k| s.structures.built(k));
+        if let Some((built, stats)) = built.and_then(|b| Some((b, b.kd?))) {
+            ui.label(format!(
+                "{} triangles; the method's kd-tree: {} nodes (depth {}, C_trav {}), built in {:.2} s",
+                s.scene.triangle_count(),
+                stats.nodes,
+                stats.max_depth,
+                s.structures.params().kd_for(method).c_trav,
+                built.seconds
+            ));
+        }
         let dropped = s.scene.dropped.total();
         if dropped > 0 {
             ui.colored_label(ui.visuals().warn_fg_color, format!("{dropped} bad triangles dropped at load"));
