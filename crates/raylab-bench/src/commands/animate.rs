@@ -98,7 +98,7 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
         let ms = |which: Structure| times.iter().find(|(s, _)| *s == which).map_or(0.0, |(_, t)| t.as_secs_f64() * 1e3);
         let updates = [ms(Structure::ThesisKd), ms(Structure::Mbvh), ms(Structure::Dacrt)];
         let (Some(tree), Some(reference)) = (structures.kd(Structure::ThesisKd), structures.reference()) else {
-            unreachable!("built above");
+            return Err("the kd-tree and the brute-force reference were not built".into());
         };
         let workload =
             WorkloadBuilder::new(&scene, &camera, light.position, a.width as u32, a.height as u32, tree).build(a.kind);

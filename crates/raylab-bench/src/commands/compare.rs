@@ -274,7 +274,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     let threads = a.threads.iter().copied().max().ok_or("--threads: no thread count given")? as usize;
     let structures = build_structures(&scene, &methods, Purpose::Rays, &structure_params, threads)?;
     let (Some(tree), Some(reference)) = (structures.kd(Structure::ThesisKd), structures.reference()) else {
-        unreachable!("built above");
+        return Err("the kd-tree and the brute-force reference were not built".into());
     };
     let (w, h) = a.image.size();
     let wb = with_spinner("generating rays", || WorkloadBuilder::new(&scene, &cam, light.position, w, h, tree));

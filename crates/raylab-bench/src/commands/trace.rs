@@ -66,7 +66,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
         with_spinner("building structures", || pool.install(|| Structures::build_these(&scene, &needs, &params)))
             .map_err(|e| e.to_string())?;
     let (Some(tree), Some(reference)) = (structures.kd(Structure::ThesisKd), structures.reference()) else {
-        unreachable!("built above");
+        return Err("the kd-tree and the brute-force reference were not built".into());
     };
     let (w, h) = a.image.size();
     let builder = with_spinner("generating rays", || {
