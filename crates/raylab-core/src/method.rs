@@ -92,7 +92,7 @@ impl Method {
     /// below the division made at setup, whatever the number of rays) outweighs the rays' own work.
     pub const DACRT_MIN_SET: u32 = 16384;
 
-    /// True for divide-and-conquer ray tracing, which needs a [`Dacrt`] instead of a stored structure.
+    /// True for divide-and-conquer ray tracing, which needs a [`Dacrt`](crate::dacrt::Dacrt) instead of a stored structure.
     pub fn uses_dacrt(self) -> bool {
         self == Method::Dacrt
     }

@@ -328,7 +328,7 @@ pub fn dispatch<K: Kernel>(backend: Backend, k: K) -> K::Output {
 }
 
 /// Which lanes [`dispatch`] ran, counted per thread when the `dispatch-log` feature is on (tests turn it on);
-/// without it [`dispatch_log::note`] is empty and [`dispatch_log::take`] always returns zeros.
+/// without it counting costs nothing and [`dispatch_log::take`] always returns zeros.
 pub mod dispatch_log {
     use super::Backend;
 
