@@ -7,7 +7,7 @@ mod isect_cost;
 mod output;
 mod timing;
 
-use raylab_bench::{args, env, prepare};
+use raylab_cli::{args, env, prepare};
 
 use clap::{Parser, Subcommand};
 

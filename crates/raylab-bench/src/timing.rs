@@ -132,8 +132,7 @@ impl TiledWorkload {
 
     /// Traces every tile once with `tracer` on the current rayon pool: the timed part of a run. Each tile is
     /// its own rayon job: with rayon's default pieces (about two per thread, split further only when
-    /// stolen) one thread was left tracing a costly part of the image alone, and two threads traced only
-    /// 1.5-1.8x one thread's rays (frustum 16 on Sponza's primary rays: 18.9 Mrays/s, against 25.4 now).
+    /// stolen) one thread can be left tracing a costly part of the image alone while the others idle.
     pub fn trace(&mut self, tracer: &Tracer) {
         let (occlusion, toward) = (self.occlusion, self.toward);
         self.tiles.par_iter_mut().with_max_len(1).for_each(|t| {

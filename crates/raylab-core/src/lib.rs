@@ -11,12 +11,14 @@
 pub mod aabb;
 pub mod dacrt;
 pub mod distribution;
+pub mod edge_width;
 pub mod intersector;
 pub mod kdtree;
 pub mod mbvh;
 pub mod method;
 pub mod packet;
 pub mod ray;
+pub mod ray_order;
 pub mod reference;
 pub mod render;
 pub mod scene;

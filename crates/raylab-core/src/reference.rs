@@ -3,10 +3,10 @@
 //! Slow by design and obviously correct; every traversal method is tested against it ("always keep a
 //! reference implementation", Akenine-Moller and Assarsson, Ray Tracing II).
 
+use crate::edge_width::{Crossing, EdgeWidth};
 use crate::intersector::Intersector;
 use crate::ray::{Hit, Ray};
 use crate::scene::Scene;
-use crate::shadow::{Crossing, EdgeWidth};
 use crate::stats::TraversalStats;
 use crate::triangle::{RayShear, TriangleSoup};
 

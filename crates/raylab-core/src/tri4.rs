@@ -4,8 +4,7 @@
 //! Packet kernels test four rays against one triangle (`crate::packet`); a single ray has no rays to fill the
 //! lanes with, so single rays through the MBVH (and the MBVH RS leaves' left-over rays) fill them with
 //! triangles instead, as Embree's four-triangle leaves do. The kd-tree's leaves stay one test per triangle:
-//! most hold one or two, where the scalar test's early exit on the edge signs is cheaper than a whole block
-//! (tried: mono fell from 3.35 to 2.33 Mrays/s on the Sponza view).
+//! most hold one or two, where the scalar test's early exit on the edge signs is cheaper than a whole block.
 //!
 //! A structure lays its leaves out in blocks: each leaf starts at a slot that is a multiple of four, so slot
 //! `s` is lane `s % 4` of block `s / 4`. Every lane performs exactly the `f32` operations of

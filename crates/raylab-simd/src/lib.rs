@@ -191,7 +191,7 @@ pub fn prefetch<T>(values: &[T]) {
 /// and does nothing elsewhere, on slices without a whole aligned stretch, or where the kernel declines.
 /// With 4 KiB pages the physical placement of a structure that fills much of the L2 cache (an MBVH ray
 /// stream's per-ray records, about 0.5 MiB for 2^12 rays) differs from run to run, and with it the cache
-/// conflicts: on Zen 5 the same stream traced 1.3x faster in some processes than in others.
+/// conflicts and the speed.
 pub fn huge_pages<T>(values: &[T]) {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {

@@ -80,7 +80,7 @@ impl AnimatedScene {
                 t => t,
             };
         }
-        match method.kernel_structure() {
+        match method.entry().structure {
             Structure::Mbvh => out.mbvh_refit_ms = update(Structure::Mbvh)?,
             Structure::Dacrt => out.dacrt_setup_ms = update(Structure::Dacrt)?,
             _ => {}
@@ -90,12 +90,12 @@ impl AnimatedScene {
 }
 
 /// The kd-tree a frame with `settings` walks, if any: the kd-tree methods' own, and the method's
-/// [`Method::frame_kd`] for edge-width shadows (always traced through it) and multi-sampled shadows (bounded
+/// [`MethodEntry::frame_kd`](raylab_core::method::MethodEntry::frame_kd) for edge-width shadows (always traced through it) and multi-sampled shadows (bounded
 /// by packets, pyramids or cones over it), in the Whitted and hybrid modes.
 fn kd_tree_walked(settings: &ViewerSettings) -> Option<Structure> {
     let m = settings.frame_method();
-    let kernel_on_kd = matches!(m.kernel_structure(), Structure::ThesisKd | Structure::PacketKd);
+    let kernel_on_kd = matches!(m.entry().structure, Structure::ThesisKd | Structure::PacketKd);
     let shadows_on_kd = settings.mode != RenderMode::Distribution
         && matches!(settings.shadows, Shadows::EdgeWidth { .. } | Shadows::MultiSample { .. });
-    (kernel_on_kd || shadows_on_kd).then(|| m.frame_kd()).flatten()
+    (kernel_on_kd || shadows_on_kd).then(|| m.entry().frame_kd).flatten()
 }

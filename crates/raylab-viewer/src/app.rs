@@ -12,7 +12,7 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 use crate::frontend::{Automation, Frontend};
-use crate::gpu::Gpu;
+use crate::gpu::device::Gpu;
 use crate::lab::{Lab, Shot, timestamped};
 
 /// Shortest time between two UI frames (caps the UI near 60 FPS).

@@ -4,8 +4,9 @@
 use std::path::PathBuf;
 
 use clap::{Parser, ValueEnum};
-use raylab_bench::args::{KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_non_negative, parse_positive};
-use raylab_core::render::{FrameView, RayOrder};
+use raylab_cli::args::{KdArgs, MethodArgs, SceneArgs, ShadeArgs, in_range, parse_non_negative, parse_positive};
+use raylab_core::ray_order::RayOrder;
+use raylab_core::render::FrameView;
 
 use crate::settings::RenderMode;
 

@@ -6,11 +6,11 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use crate::capture::capture;
-use crate::compositor::Compositor;
 use crate::cpu_clock::{Cost, Stamp};
-use crate::gpu::Gpu;
-use crate::hybrid::HybridGpu;
+use crate::gpu::capture::capture;
+use crate::gpu::compositor::Compositor;
+use crate::gpu::device::Gpu;
+use crate::gpu::hybrid::HybridGpu;
 use crate::lab::{Lab, StatsReport};
 use crate::settings::RenderMode;
 
@@ -154,7 +154,7 @@ pub struct Automation {
 #[derive(Serialize)]
 struct StatsFile<'a> {
     /// The machine and build, as `raylab-bench`'s JSON reports give them.
-    environment: raylab_bench::env::Environment,
+    environment: raylab_cli::env::Environment,
     scene: &'a str,
     triangles: usize,
     gpu: &'a str,
@@ -207,7 +207,7 @@ impl Automation {
         if let Some(p) = &self.json_stats {
             let latest = lab.latest().ok_or("no frame was traced")?;
             let file = StatsFile {
-                environment: raylab_bench::env::Environment::detect(),
+                environment: raylab_cli::env::Environment::detect(),
                 scene: &lab.scene().name,
                 triangles: lab.scene().scene.triangle_count(),
                 gpu: &lab.gpu_name,

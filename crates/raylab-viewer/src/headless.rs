@@ -6,7 +6,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use crate::frontend::{Automation, Frontend};
-use crate::gpu::Gpu;
+use crate::gpu::device::Gpu;
 use crate::lab::Lab;
 
 /// Target format of the offscreen run.

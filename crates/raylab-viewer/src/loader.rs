@@ -6,15 +6,15 @@ use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use raylab_bench::args::SceneArgs;
+use raylab_cli::args::SceneArgs;
 use raylab_core::method::{Method, Purpose};
 use raylab_core::scene::{Camera, PointLight, Scene};
 use raylab_core::structures::{StructureParams, Structures};
 
-/// The methods the viewer offers: every one but the brute-force reference
-/// ([`crate::settings::ViewerSettings::method_unavailable`]).
+/// The methods the viewer offers: every one whose entry allows live frames
+/// ([`raylab_core::method::MethodEntry::not_live`]).
 pub fn viewer_methods() -> impl Iterator<Item = Method> {
-    Method::ALL.into_iter().filter(|&m| m != Method::Reference)
+    Method::ALL.into_iter().filter(|m| m.entry().not_live.is_none())
 }
 
 /// A scene ready to trace: the triangles, the structures of every viewer method, and the view and light it

@@ -6,33 +6,24 @@
 
 mod animated;
 mod app;
-mod camera_path;
-mod capture;
+mod camera;
 mod cli;
-mod compare;
-mod compositor;
 mod cpu_clock;
-mod fly;
-mod fly_scale;
 mod frontend;
 mod gpu;
 mod headless;
-mod hybrid;
 mod lab;
 mod loader;
 mod settings;
-mod tracer_priority;
-mod ui_cover;
-mod ui_fill;
-mod worker;
+mod tracer;
 
 use std::process::ExitCode;
 use std::sync::Arc;
 
 use clap::Parser;
-use raylab_bench::prepare::with_spinner;
+use raylab_cli::prepare::with_spinner;
 
-use crate::camera_path::CameraPath;
+use crate::camera::paths::CameraPath;
 use crate::cli::Cli;
 use crate::frontend::Automation;
 use crate::lab::Lab;
@@ -81,7 +72,7 @@ fn run(cli: &Cli) -> Result<(), String> {
         continuous: true,
         animate: cli.animate,
     };
-    if let Some(why) = settings.method_unavailable(settings.trace.method) {
+    if let Some(why) = settings.trace.method.entry().not_live {
         return Err(format!("--method {}: {why}", settings.trace.method));
     }
     settings.shadows.validate().map_err(|e| format!("--shadows: {e}"))?;

@@ -4,7 +4,8 @@
 use clap::ValueEnum;
 use raylab_core::distribution::DistributionSettings;
 use raylab_core::method::Method;
-use raylab_core::render::{FrameView, RayOrder, RenderSettings};
+use raylab_core::ray_order::RayOrder;
+use raylab_core::render::{FrameView, RenderSettings};
 use raylab_core::shadow::Shadows;
 use raylab_core::trace::TraceOptions;
 use serde::Serialize;
@@ -121,7 +122,7 @@ pub struct ViewerSettings {
     /// Render resolution in percent of the window (25-100).
     pub scale: u32,
     /// Trace at a lower scale while the camera flies, when a frame at `scale` would miss the fly budget
-    /// ([`crate::fly_scale`]).
+    /// ([`crate::camera::fly_scale`]).
     pub fly_scale: bool,
     /// Tracer threads.
     pub threads: usize,
@@ -158,13 +159,5 @@ impl ViewerSettings {
     /// The method that traces this mode's rays: the reflection method in hybrid mode, else the method.
     pub fn frame_method(&self) -> Method {
         if self.mode == RenderMode::Hybrid { self.hybrid.method } else { self.trace.method }
-    }
-
-    /// Why `method` cannot be chosen in the current mode, if it cannot.
-    pub fn method_unavailable(&self, method: Method) -> Option<&'static str> {
-        match method {
-            Method::Reference => Some("brute force over every triangle: for tests, far too slow to fly with"),
-            _ => None,
-        }
     }
 }

@@ -8,10 +8,11 @@
 use std::path::Path;
 use std::process::Command;
 
-use raylab_bench::args::SceneArgs;
-use raylab_bench::still::render_still;
+use raylab_cli::args::SceneArgs;
+use raylab_cli::still::render_still;
 use raylab_core::method::{Method, Purpose};
-use raylab_core::render::{FrameView, RayOrder, RenderSettings};
+use raylab_core::ray_order::RayOrder;
+use raylab_core::render::{FrameView, RenderSettings};
 use raylab_core::scene::PointLight;
 use raylab_core::shadow::{SampleBound, ShadowKind};
 use raylab_core::structures::{StructureParams, Structures};
@@ -269,7 +270,7 @@ fn hybrid_mode_reflections_match_the_cpu_renderer() {
     use raylab_core::trace::Tracer;
     let dir = tempfile::tempdir().unwrap();
     let args = SceneArgs::named("atrium");
-    let (scene, _) = raylab_bench::prepare::load_scene(&args.source()).unwrap();
+    let (scene, _) = raylab_cli::prepare::load_scene(&args.source()).unwrap();
     let (camera, light) = args.camera_and_light(&scene).unwrap();
     let structures = Structures::build(&scene, &[Method::Mono], Purpose::Frames, &StructureParams::default()).unwrap();
     let tracer = Tracer::new(&structures, TraceOptions::default()).unwrap();

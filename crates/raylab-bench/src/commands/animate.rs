@@ -107,7 +107,7 @@ pub fn run(a: &AnimateArgs) -> Result<(), String> {
         for ((method, _), (row, update)) in methods.iter().zip(rows.iter_mut().zip(updates)) {
             let options = TraceOptions { method: *method, ..TraceOptions::default() };
             let tracer = Tracer::for_rays(&structures, options).map_err(|e| e.to_string())?;
-            let tile = if method.uses_dacrt() { DACRT_SET_TILE } else { HARNESS_TILE };
+            let tile = if method.entry().structure == Structure::Dacrt { DACRT_SET_TILE } else { HARNESS_TILE };
             let t = Instant::now();
             let (results, _) = pool.install(|| trace_once(&tracer, &workload, tile));
             let trace = t.elapsed().as_secs_f64() * 1e3;

@@ -269,7 +269,7 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
     }
     // Every traced method's structures, and the brute force that validates them.
     let mut methods = vec![Method::Mono, Method::Reference];
-    methods.extend(a.methods.iter().filter(|m| m.uses_packets()));
+    methods.extend(a.methods.iter().filter(|m| m.entry().packets()));
     methods.extend(&a.incoherent);
     let threads = a.threads.iter().copied().max().ok_or("--threads: no thread count given")? as usize;
     let structures = build_structures(&scene, &methods, Purpose::Rays, &structure_params, threads)?;
@@ -306,8 +306,9 @@ pub fn run(a: &CompareArgs) -> Result<(), String> {
                 continue;
             }
             // Coherent methods: every tile size for the frustum methods.
-            for &method in a.methods.iter().filter(|m| m.uses_packets()) {
-                let tiles: Vec<u64> = if method.uses_tiles() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
+            for &method in a.methods.iter().filter(|m| m.entry().packets()) {
+                let tiles: Vec<u64> =
+                    if method.entry().tile_matters() { a.tiles.clone() } else { vec![u64::from(HARNESS_TILE)] };
                 for &tile in &tiles {
                     for &t in &a.threads {
                         let options = TraceOptions { method, ..Default::default() };
@@ -538,7 +539,7 @@ fn incoherent_runs(
 ) -> Result<Incoherent, String> {
     let reference = structures.reference().ok_or("the brute-force reference was not built")?;
     let mut mbvh_builds = Vec::new();
-    if a.incoherent.iter().any(|m| m.uses_mbvh()) {
+    if a.incoherent.iter().any(|m| m.entry().structure == Structure::Mbvh) {
         for &t in &a.threads {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(t as usize).build().map_err(|e| e.to_string())?;
             let mut times = Vec::new();
@@ -561,12 +562,12 @@ fn incoherent_runs(
             let options = TraceOptions { method, stream_group: group.map(|g| g as usize), ..Default::default() };
             let tracer = Tracer::for_rays(structures, options).map_err(|e| e.to_string())?;
             let tile = match group {
-                _ if method.uses_dacrt() => DACRT_TILE,
+                _ if (method.entry().structure == Structure::Dacrt) => DACRT_TILE,
                 Some(g) => tile_for_group(HARNESS_TILE, g as u32),
                 None => HARNESS_TILE,
             };
             let setup = || drop(Dacrt::new(scene));
-            let setup = method.uses_dacrt().then_some(&setup as &(dyn Fn() + Sync));
+            let setup = (method.entry().structure == Structure::Dacrt).then_some(&setup as &(dyn Fn() + Sync));
             let runs = (t as usize, a.warmup as usize, a.reps as usize);
             let (report, results) = measure(&tracer, workload, tile, runs, setup)?;
             validate(reference, workload, &results, 256).map_err(|m| format!("validation failed ({method}): {m}"))?;

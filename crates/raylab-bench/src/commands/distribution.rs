@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use raylab_core::distribution::{Accumulator, BounceStats, DistributionSettings, render_pass};
-use raylab_core::method::{Method, Purpose};
+use raylab_core::method::{Method, Purpose, Structure};
 use raylab_core::stats::TraversalStats;
 use raylab_core::structures::StructureParams;
 use raylab_core::trace::{TraceOptions, Tracer};
@@ -255,7 +255,7 @@ fn write_tables(md: &mut String, runs: &[Run], bounces: usize, speeds_only: Opti
         bounce_header(md, "method | group | rays");
         let _ = writeln!(md);
         let _ = writeln!(md, "|---|---:|---|{}", "---:|".repeat(bounces + 1));
-        for r in runs.iter().filter(|r| !r.sweep && (!mbvh_only || r.method.uses_mbvh())) {
+        for r in runs.iter().filter(|r| !r.sweep && (!mbvh_only || r.method.entry().structure == Structure::Mbvh)) {
             for (kind, pick) in [("reflection", 0), ("shadow", 1)] {
                 let _ = write!(md, "| {} | {kind} |", r.label());
                 for b in &r.bounces {

@@ -5,9 +5,10 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use raylab_bench::env::Environment;
-use raylab_bench::still::{Still, render_still};
-use raylab_core::render::{FrameView, RayOrder, RenderSettings};
+use raylab_cli::env::Environment;
+use raylab_cli::still::{Still, render_still};
+use raylab_core::ray_order::RayOrder;
+use raylab_core::render::{FrameView, RenderSettings};
 use raylab_core::scene::PointLight;
 use serde_json::json;
 

@@ -16,7 +16,7 @@ use raylab_core::trace::{TraceOptions, Tracer};
 
 use serde_json::{Value, json};
 
-use super::tables::{Cell, measure, measure_interleaved, record};
+use super::frame_cells::{Cell, measure, measure_interleaved, record};
 
 /// Samples per point of the image-quality table's reference.
 const REFERENCE_SAMPLES: u32 = 1024;

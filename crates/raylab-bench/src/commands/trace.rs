@@ -60,7 +60,7 @@ pub fn run(a: &TraceArgs) -> Result<(), String> {
     // The method's structure, the thesis's kd-tree that traces the harness's primary pass (the hit points the
     // shadow and diffuse rays leave from), and the brute force the results are validated against.
     let params = a.kd.structure_params()?;
-    let needs = [a.m.method.kernel_structure(), Structure::ThesisKd, Structure::Reference];
+    let needs = [a.m.method.entry().structure, Structure::ThesisKd, Structure::Reference];
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads as usize).build().map_err(|e| e.to_string())?;
     let structures =
         with_spinner("building structures", || pool.install(|| Structures::build_these(&scene, &needs, &params)))

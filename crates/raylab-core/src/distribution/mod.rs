@@ -108,7 +108,7 @@ pub fn render_pass(
 ) -> Vec<BounceStats> {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     assert!(acc.width == w && acc.height == h, "accumulator size");
-    let tile = tracer.options.method.tile_edge(settings.tile, settings.spp);
+    let tile = tracer.options.method.entry().tile_edge(settings.tile, settings.spp);
     let ctx =
         Pass { scene, tracer, raster: camera.raster(w, h), light, settings, pass, epsilon: surface_epsilon(scene) };
     let tiles: Vec<(u32, u32)> =

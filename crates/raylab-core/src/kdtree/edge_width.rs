@@ -24,9 +24,9 @@ use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
 use crate::aabb::Aabb;
+use crate::edge_width::{Crossing, EdgeWidth};
 use crate::packet::{BatchCull, Bundle, PacketTester, PacketTile, RayPacket, map3, overlaps_box};
 use crate::ray::Ray;
-use crate::shadow::{Crossing, EdgeWidth};
 use crate::stats::TraversalStats;
 use crate::triangle::RayShear;
 

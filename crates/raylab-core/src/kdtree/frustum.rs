@@ -46,8 +46,7 @@ pub(super) struct Leaf<'a> {
 
 impl Leaf<'_> {
     /// Starts loading the leaf's triangles, once per leaf visit and before [`leaf_intersect`] looks up its
-    /// box and culls its packets, so the first packet's tests wait less on their corners (primary MFT 32x32
-    /// about 1.02x, docs/BENCHMARKS.md).
+    /// box and culls its packets, so the first packet's tests wait less on their corners.
     #[inline(always)]
     pub(super) fn prefetch_triangles(&self) {
         let tris = self.tree.triangles();
@@ -337,8 +336,8 @@ impl KdTree {
     /// Marks in `blocked` the lanes of packets `set` that something blocks. The frustum `f` must bound the
     /// rays' segments; it may be built from the other end of the segments, e.g. from a light, and then
     /// `far_first` walks the far child of each split first: the blockers of a shadow segment lie mostly
-    /// near its surface end, so starting there finishes packets sooner (Sponza's hard shadows, MFT 16x16:
-    /// 9% fewer triangle tests, 6.5% fewer instructions; docs/BENCHMARKS.md). From the surface end (the
+    /// near its surface end, so starting there finishes packets sooner, with fewer triangle tests. From the
+    /// surface end (the
     /// bundles of a point's light samples) the near child comes first.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]

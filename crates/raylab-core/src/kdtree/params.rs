@@ -56,14 +56,12 @@ impl KdParams {
     /// against the thesis's 1 (with `c_isect` 5 in both).
     ///
     /// A frustum walk pays a node step once for a whole tile, but at each leaf it tests every packet of the
-    /// (sub)frustum against the leaf's box before any triangle, and on Sponza's primary rays a leaf of the
-    /// thesis's tree (2.4 triangles) serves about two rays: its visits, not its triangle tests, dominate. A
-    /// packet's SIMD triangle test, too, costs little against a step of its walk. The SAH has no term for a
-    /// leaf visit, so the split cost carries it; a larger `c_trav` gives fewer, fuller leaves (Sponza: 130k
-    /// nodes and 5.7 triangles per leaf against 473k and 2.4). 12 is the best of a sweep over 1-24 for
-    /// MFT, frustum and cone on primary and shadow rays with AVX2 and AVX-512 (1.2-1.5x the rays per second
-    /// of the thesis's tree), and packets gain 1.05-1.15x on primary, shadow and diffuse rays
-    /// (docs/BENCHMARKS.md); single rays move within the noise, so they keep the thesis's model.
+    /// (sub)frustum against the leaf's box before any triangle, and a leaf of the thesis's tree serves only a
+    /// few rays: its visits, not its triangle tests, dominate. A packet's SIMD triangle test, too, costs little
+    /// against a step of its walk. The SAH has no term for a leaf visit, so the split cost carries it; a
+    /// larger `c_trav` gives fewer, fuller leaves. 12 is the best of a sweep over 1-24 for the frustum methods
+    /// on primary and shadow rays, and packets gain from it too; single rays do not, so they keep the thesis's
+    /// model.
     pub const PACKET_C_TRAV: f32 = 12.0;
 
     /// The depth limit used for a scene of `n` triangles.

@@ -2,9 +2,7 @@
 //! Dietrich 2009), the halves built in parallel with rayon, then collapsed into 4-wide nodes by the SAH: each
 //! binary node's [`Collapse`] plan says how its subtree best fills one to four lanes (Ylitie, Karras and
 //! Laine 2017). The MBVH RS paper opens the child of largest area until four lanes are full (Wald et al.
-//! 2008); the plan's lanes are never costlier, and on Sponza's diffuse rays they take 4-box tests per ray
-//! from 14.47 to 14.17 for single rays and from 16.93 to 16.45 for MBVH RS at 2^12, with 7,863 nodes
-//! instead of 8,837 (85% of lanes used instead of 78%).
+//! 2008); the plan's lanes are never costlier by the SAH, and they fill more lanes with fewer nodes.
 //!
 //! Each node first looks for an object split: 16 bins on each of the three axes of its references'
 //! centroids. Where the two halves of the best one overlap by more than [`SPATIAL_OVERLAP`] of the root's
@@ -18,6 +16,7 @@ use glam::{UVec3, Vec3, Vec3A};
 
 use super::MbvhParams;
 use super::node::{EMPTY, MbvhNode};
+use super::sah::{BINS, C_TRAV, Context, Extent, PARALLEL_MIN, Parts, Ref, leaf_cost};
 use super::spatial::{SpatialSplit, best_spatial, partition_space};
 use crate::aabb::{Aabb, coord};
 use crate::tri4;
@@ -26,37 +25,12 @@ use crate::tri4;
 pub const MAX_LEAF: usize = 8;
 /// Most references [`Collapse`] merges into one leaf lane.
 const MAX_MERGED_LEAF: usize = 8;
-/// SAH bins per node and axis, for object and for spatial splits.
-pub(super) const BINS: usize = 16;
-/// SAH cost of a node: one 4-box test, the unit of the SAH costs here.
-pub(super) const C_TRAV: f32 = 1.0;
-/// SAH cost of one ray against a four-triangle block ([`tri4`]'s watertight test). Counting leaves by
-/// blocks rather than triangles (cost 1 each) makes leaves of up to four triangles: on Sponza's diffuse rays
-/// 4-box tests per single ray fall from 15.19 to 14.47 for 9.42 triangle tests instead of 5.31, single-ray
-/// MBVH runs 1.07x, MBVH RS 1.06x at 2^8 and 1.02x at 2^12 (costs of 1 to 4 per block came out alike).
-const C_BLOCK: f32 = 2.0;
 /// Binary depth from which lists are halved instead of split by SAH, so that the tree (and the traversal
 /// stack) stays shallow whatever the input: at most 48 SAH levels, then log2 of the rest.
 const MAX_SAH_DEPTH: u32 = 48;
-/// Nodes with at least this many references build their halves in parallel.
-pub(super) const PARALLEL_MIN: usize = 4096;
 /// Spatial splits are tried where the best object split's halves overlap by at least this fraction of the
 /// root's surface area (Stich et al.'s alpha).
 const SPATIAL_OVERLAP: f32 = 1e-5;
-
-/// A triangle reference: a triangle and the part of its box inside the node that holds it (the whole box,
-/// unless spatial splits cut the triangle).
-#[derive(Clone, Copy)]
-pub(super) struct Ref {
-    pub(super) bounds: Aabb,
-    pub(super) id: u32,
-}
-
-impl Ref {
-    fn centroid(&self) -> Vec3 {
-        self.bounds.center()
-    }
-}
 
 /// A binary build node. A leaf owns its triangle ids: a triangle cut by spatial splits is in several leaves
 /// (at most once in each). Each node carries its [`Collapse`] plan, made as the build returns up the tree.
@@ -109,7 +83,7 @@ impl Bin {
 /// A subtree stands in its parent's 4-wide node as up to four lanes: as one leaf lane holding all its
 /// triangles, as one lane pointing at a 4-wide node of its own, or split between its two children's lanes.
 /// Costs are the SAH's, area-weighted: a 4-wide node costs its area times [`C_TRAV`] (one 4-box test), a
-/// leaf its area times its blocks' [`C_BLOCK`]. Unlike opening the widest child until four lanes are full,
+/// leaf its area times its blocks' [`C_BLOCK`](super::sah::C_BLOCK). Unlike opening the widest child until four lanes are full,
 /// this also merges small leaves into one lane and leaves lanes empty where filling them costs more.
 #[derive(Clone, Copy)]
 struct Collapse {
@@ -179,15 +153,6 @@ pub struct Built {
     pub binary_nodes: usize,
     /// Triangle references in the leaves, padding aside (the triangle count plus the spatial splits' copies).
     pub references: usize,
-}
-
-/// What every level of the build reads.
-pub(super) struct Context<'a> {
-    pub(super) tris: &'a [[Vec3; 3]],
-    /// Surface area of the root's box, the measure of [`SPATIAL_OVERLAP`].
-    pub(super) root_area: f32,
-    /// Nodes with fewer references make object splits only.
-    pub(super) spatial_min: usize,
 }
 
 /// Builds over triangles given by their corners.
@@ -288,26 +253,6 @@ fn collapse(n: &Bin, at: usize, nodes: &mut Vec<MbvhNode>, ids: &mut Vec<u32>) {
     }
     debug_assert!(nodes[at].child.iter().any(|&c| c != EMPTY));
 }
-
-/// The box of some references and the box of their centroids.
-#[derive(Clone, Copy)]
-pub(super) struct Extent {
-    pub(super) bounds: Aabb,
-    pub(super) centroids: Aabb,
-}
-
-impl Extent {
-    /// The extent of `refs`, by a pass over them.
-    pub(super) fn of(refs: &[Ref]) -> Self {
-        refs.iter().fold(Extent { bounds: Aabb::EMPTY, centroids: Aabb::EMPTY }, |e, r| Extent {
-            bounds: e.bounds.union(r.bounds),
-            centroids: e.centroids.grow(r.centroid()),
-        })
-    }
-}
-
-/// Two children's references and extents.
-pub(super) type Parts = (Vec<Ref>, Extent, Vec<Ref>, Extent);
 
 /// Builds the binary subtree over `refs` (spanning `extent`), which may hold at most `budget` references
 /// in all: what spatial splits may copy. An object split hands each child its extent, the reference boxes
@@ -418,12 +363,6 @@ fn partition_objects(refs: &mut Vec<Ref>, extent: &Extent, s: &Split) -> Option<
     let right = refs.split_off(mid);
     let left = std::mem::take(refs);
     Some((left, Extent { bounds: s.left, centroids: left_c }, right, Extent { bounds: s.right, centroids: right_c }))
-}
-
-/// SAH cost of a leaf of `n` triangles: its four-triangle blocks, as leaves are padded to whole blocks and a
-/// ray tests one block at a time, so one to four triangles cost the same.
-pub(super) fn leaf_cost(n: usize) -> f32 {
-    n.div_ceil(4) as f32 * C_BLOCK
 }
 
 /// [`Aabb::surface_area`] of the box `[lo, hi]`, on 16-byte vectors (the same operations in the same order).

@@ -4,6 +4,7 @@
 mod build;
 mod node;
 mod refit;
+mod sah;
 mod single;
 mod spatial;
 mod stream;
@@ -48,11 +49,8 @@ pub struct Mbvh {
 pub struct MbvhParams {
     /// Nodes with fewer triangle references than this make object splits only. Spatial splits pay most at
     /// the top of the tree, where one long triangle stretches a big box; further down they cost more build
-    /// time than they save. On Sponza's diffuse rays in MBVH RS at 2^12, 4-box tests per ray went from 20.50
-    /// without spatial splits to 16.93 with the default (71,450 references for 66,453 triangles) and 16.04
-    /// with 0 (80,257 references), for 0.032 s against 0.116 s of build on two threads, with no gain in
-    /// speed beyond the runs' spread (measured with the widest-first collapse; the SAH-planned one takes the
-    /// default's 16.93 to 16.45). `usize::MAX` turns them off.
+    /// time than they save: splitting everywhere cuts box tests a little more, for several times the build
+    /// time and more references. `usize::MAX` turns them off.
     pub spatial_min_refs: usize,
     /// References the whole tree may hold per triangle (at least 1): spatial splits stop once a subtree has
     /// used its share.

@@ -6,7 +6,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::build::{BINS, C_TRAV, Context, Extent, PARALLEL_MIN, Parts, Ref, leaf_cost};
+use super::sah::{BINS, C_TRAV, Context, Extent, PARALLEL_MIN, Parts, Ref, leaf_cost};
 use crate::aabb::{Aabb, coord, coord_mut};
 use crate::kdtree::clip::split_clipped_bounds;
 

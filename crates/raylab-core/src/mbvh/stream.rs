@@ -11,7 +11,7 @@
 //! packet of them would leave most lanes idle. The default: a vector's worth of rays at a time against the
 //! leaf's four-triangle blocks, each group of four lanes one ray against four triangles
 //! ([`crate::tri4::ShearGroups`]), with every ray's shear computed once per stream. Few rays reach a leaf
-//! together in a scattered group (on Sponza's diffuse rays 5.3 per leaf visit at 2^12 and 2.3 at 2^8), so
+//! together in a scattered group (a handful per leaf visit, fewer in smaller groups), so
 //! the paper's packets run part empty, while a block is full whenever the leaf is; and a packet gathers its
 //! rays' constants anew at every leaf. The leaf counters (Figure 6's primitive tests) count SIMD tests:
 //! packet against triangle, or ray against four triangles.
@@ -183,10 +183,9 @@ struct StreamRays<'a> {
 }
 
 /// Buffers for [`StreamRays`], kept per thread from group to group and backed by huge pages where the
-/// kernel allows ([`raylab_simd::huge_pages`]): a 2^12-ray group's state, about 0.5 MiB, fills half of a
-/// Zen 5 core's L2 cache, and with 4 KiB pages its placement, and so its cache conflicts, changed from
-/// process to process and from group to group (the same stream traced at 4.5-6.0 Mrays/s on one thread;
-/// 6.0-6.5 with huge pages).
+/// kernel allows ([`raylab_simd::huge_pages`]): a 2^12-ray group's state, about 0.5 MiB, fills much of a
+/// core's L2 cache, and with 4 KiB pages its placement, and so its cache conflicts, would change from
+/// process to process and from group to group, and the speed with them.
 #[derive(Default)]
 struct Scratch {
     hot: Vec<Hot>,
@@ -635,9 +634,9 @@ impl Mbvh {
 }
 
 /// A group traced with the backend's lane type ([`raylab_simd::dispatch`]): eight lanes test two rays per node
-/// and leave the leaves to SSE's four, four lanes do both. Sixteen (four rays per node test, each chunk's
-/// pushes by AVX-512 compress) measured slower (4.24 against 4.65 Mrays/s at 2^12, 2.87 against 3.34 at 2^8,
-/// Sponza's diffuse rays), so streams run as under AVX2 there ([`raylab_simd::Backend::at_most_eight_lanes`]).
+/// and leave the leaves to SSE's four, four lanes do both. Under AVX-512 streams run as under AVX2
+/// ([`raylab_simd::Backend::at_most_eight_lanes`]): four rays per node test leave more lanes idle in a
+/// scattered stream than they save.
 struct Stream<'a, F> {
     mbvh: &'a Mbvh,
     rays: &'a [Option<Ray>],

@@ -104,8 +104,8 @@ impl BatchCull {
     /// minima and maxima of the same inverses). `farthest` holds each packet's largest `tmax` (the tile's
     /// `farthest_hit` before any hit). `None` when the data cannot tell: `origin` is not the batch's, or a
     /// packet of `set` has no range on some axis (rays going both ways or parallel to it, or no valid ray);
-    /// the caller then builds the frustum from the packets. MFT builds four frustums a tile, and building them
-    /// from the packets cost 3.6% of a primary MFT 16x16 trace (docs/BENCHMARKS.md, session 52).
+    /// the caller then builds the frustum from the packets. MFT builds four frustums a tile, where a pass over
+    /// every ray of the packets would be a visible share of the trace.
     #[inline(always)]
     pub fn frustum<V: Vf32>(&self, origin: Vec3, set: Range<usize>, farthest: &[f32]) -> Option<Frustum> {
         if origin != self.origin || set.is_empty() {

@@ -19,7 +19,7 @@
 use glam::Vec3;
 use raylab_simd::{VMask, Vf32};
 
-use super::{Disc, Frustum, RayPacket, tile::Bundle};
+use super::{Bundle, Disc, Frustum, RayPacket};
 
 /// A cone bounding a bundle of rays from one origin.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -4,6 +4,8 @@
 mod batch_cull;
 mod cone;
 mod disc;
+mod frustum;
+mod slab;
 mod tile;
 mod woop;
 
@@ -15,8 +17,10 @@ use crate::ray::{Hit, Ray};
 pub use batch_cull::BatchCull;
 pub use cone::Cone;
 pub use disc::Disc;
-pub(crate) use tile::SignBounds;
-pub use tile::{Bundle, Frustum, PacketTile, overlaps_box, packet_shape, slab_interval};
+pub(crate) use frustum::SignBounds;
+pub use frustum::{Bundle, Frustum};
+pub use slab::{overlaps_box, slab_interval};
+pub use tile::{PacketTile, packet_shape};
 pub use woop::{PacketTester, intersect_packet, occlude_packet};
 pub(crate) use woop::{Sheared, sheared_test};
 

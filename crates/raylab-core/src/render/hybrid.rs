@@ -7,7 +7,6 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::method::Method;
 use crate::ray::{Hit, Ray};
 use crate::scene::{Camera, PointLight, Scene};
 use crate::stats::TraversalStats;
@@ -75,8 +74,9 @@ pub fn shade_reflections(
 /// Linear colours of the reflection rays `set` (each with the index of its pixel in the `width x height`
 /// layer of `settings`, which seeds its light samples), traced with `tracer` and shaded one bounce deep under
 /// `settings.shadows`, in the order of `set`; black where a ray hits nothing. The rays are cut into sets
-/// shared among the threads of the current rayon pool (for DACRT, sets of at least
-/// [`Method::DACRT_MIN_SET`] rays, since each set divides its triangles again below the setup's division).
+/// shared among the threads of the current rayon pool (for the methods that ask for it, at least
+/// [`min_tile_rays`](crate::method::MethodEntry::min_tile_rays) rays a set: DACRT divides its triangles
+/// again for every set).
 /// The hybrid mode passes only its reflective pixels, so its cost follows their number rather than the
 /// G-buffer's size.
 pub fn shade_reflection_set(
@@ -89,7 +89,7 @@ pub fn shade_reflection_set(
 ) -> (Vec<Vec3>, TraversalStats, StageTimes) {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     let threads = rayon::current_num_threads().max(1);
-    let min_set = if tracer.options.method.uses_dacrt() { Method::DACRT_MIN_SET as usize } else { MIN_CHUNK };
+    let min_set = tracer.options.method.entry().min_tile_rays().map_or(MIN_CHUNK, |n| n as usize);
     let chunk = set.len().div_ceil(threads).max(min_set).max(1);
     let one_bounce = RenderSettings { max_depth: 1, ..*settings };
     let ctx = TileContext {
@@ -100,7 +100,7 @@ pub fn shade_reflection_set(
         settings: &one_bounce,
         width: w,
         epsilon: surface_epsilon(scene),
-        order: super::RayOrder::Scanline,
+        order: crate::ray_order::RayOrder::Scanline,
         tile: settings.tile,
         offsets: Vec::new(),
         plain: super::plain::PlainMaterials::of(scene),

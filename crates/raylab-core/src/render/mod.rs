@@ -4,7 +4,6 @@
 //! diagnostic [`FrameView`]s.
 
 pub mod hybrid;
-mod order;
 mod plain;
 pub mod shade;
 mod stages;
@@ -12,7 +11,6 @@ mod view;
 mod visibility;
 mod whitted;
 
-pub use order::RayOrder;
 pub use stages::StageTimes;
 pub use view::{FrameView, depth_grey, heat_color};
 pub use visibility::{ShadowScratch, ShadowTracer};
@@ -25,10 +23,11 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::ray::{Hit, Ray};
+use crate::ray_order::RayOrder;
 use crate::scene::{Camera, PointLight, PrimaryGrid, Scene};
 use crate::shadow::Shadows;
 use crate::stats::TraversalStats;
-use crate::trace::{TraceOptions, Tracer};
+use crate::trace::Tracer;
 use shade::to_display_rgba;
 
 /// Options of one rendered frame.
@@ -124,9 +123,9 @@ impl TileOut {
 /// (install a pool to choose the thread count).
 pub fn render(scene: &Scene, tracer: &Tracer, camera: &Camera, light: PointLight, settings: &RenderSettings) -> Frame {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
-    let tile = tracer.options.method.tile_edge(settings.tile, 1);
+    let tile = tracer.options.method.entry().tile_edge(settings.tile, 1);
     // Single rays are traced in the chosen order; packet methods need the tile's pixels row by row.
-    let order = if tracer.options.method.uses_packets() { RayOrder::Scanline } else { settings.order };
+    let order = if tracer.options.method.entry().packets() { RayOrder::Scanline } else { settings.order };
     let ctx = TileContext {
         scene,
         tracer,
@@ -217,19 +216,6 @@ fn depth_color(t: f32, near: f32, far: f32) -> [u8; 4] {
     depth_grey(if far > near { (t - near) / (far - near) } else { 0.0 })
 }
 
-/// Width and height of the blocks a method traces as one unit: a ray, a packet
-/// ([`crate::packet::packet_shape`]), or the whole tile for frustums.
-fn unit_size(options: &TraceOptions, tile: u32) -> (u32, u32) {
-    if options.method.uses_tiles() {
-        (tile, tile)
-    } else if options.method.uses_packets() {
-        let (w, h) = crate::packet::packet_shape(options.backend.lanes());
-        (w as u32, h as u32)
-    } else {
-        (1, 1)
-    }
-}
-
 thread_local! {
     /// Each rayon worker's tile scratch buffers, kept from tile to tile and frame to frame.
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
@@ -255,7 +241,7 @@ struct TileContext<'a> {
     width: u32,
     epsilon: f32,
     order: RayOrder,
-    /// Tile edge (the method's, see [`crate::method::Method::tile_edge`]).
+    /// Tile edge (the method's, see [`crate::method::MethodEntry::tile_edge`]).
     tile: u32,
     /// The pixel offsets of a whole tile in `order`, computed once per frame.
     offsets: Vec<(u32, u32)>,
@@ -293,7 +279,7 @@ impl TileContext<'_> {
             self.block((x0, y0), (tw, th), offsets, self.order == RayOrder::Scanline, &mut out, scratch);
             return out;
         }
-        let (uw, uh) = unit_size(&self.tracer.options, self.tile);
+        let (uw, uh) = self.tracer.options.method.entry().unit_size(self.tracer.options.backend, self.tile);
         for uy in (0..th).step_by(uh as usize) {
             for ux in (0..tw).step_by(uw as usize) {
                 let before = out.stats;

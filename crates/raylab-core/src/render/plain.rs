@@ -28,8 +28,8 @@ impl TileContext<'_> {
     /// `i` at image position `sc.pixels[i]`) into the tile `out` and returns true, when every hit is on a
     /// plain surface ([`is_plain`]) and the frame's shadows trace one segment per point to the light's
     /// centre (hard, cached, edge widths; `ShadowTracer::segment_visibility`) or are off; returns false
-    /// otherwise, and the caller shades the layer hit by hit (`shade_layer`). The same pixels either way;
-    /// this way Sponza's hard-shadow MFT frame takes 13% fewer instructions (docs/BENCHMARKS.md, session 54).
+    /// otherwise, and the caller shades the layer hit by hit (`shade_layer`). The same pixels either way, for
+    /// fewer instructions: the lanes share each operation.
     pub(super) fn shade_plain(&self, dims: (usize, usize), out: &mut TileOut, sc: &mut Scratch) -> bool {
         let shadowed = match self.settings.shadows {
             Shadows::None => false,

@@ -11,16 +11,17 @@
 
 use raylab_simd::{Kernel, Vf32};
 
-use crate::method::Method;
+use crate::edge_width::EdgeWidth;
+use crate::method::Walk;
 use crate::packet::{MAX_LANES, packet_shape};
 use crate::ray::{Hit, Ray};
 use crate::scene::{PointLight, Scene};
-use crate::shadow::{EdgeWidth, LightSamples, SampleBound, ShadowCache, Shadows};
+use crate::shadow::{LightSamples, SampleBound, ShadowCache, Shadows};
 use crate::stats::TraversalStats;
 use crate::trace::{Proxy, TileScratch, Tracer};
 
-use super::order::RayOrder;
 use super::shade::{Surface, shadow_ray};
+use crate::ray_order::RayOrder;
 
 /// State of the shadow techniques (the shadow cache, edge-width buffers, light samples), reused from
 /// layer to layer and tile to tile ([`ShadowScratch::start_tile`]); one per worker, never shared.
@@ -62,8 +63,8 @@ impl ShadowScratch {
 
     /// Fills `walks` and `walk_pixels` with the segments of `rays` (a `width x height` layer) in Morton order,
     /// so that the walks' packets and bundles, which take consecutive segments, hold compact blocks of
-    /// pixels rather than strips of rows (a 4x4 block for sixteen lanes): walked in row order, Sponza's
-    /// edge-width shadow stage took about 1.1x as long (docs/BENCHMARKS.md, shading readings).
+    /// pixels rather than strips of rows (a 4x4 block for sixteen lanes), whose segments share more of the
+    /// tree than a strip's.
     fn gather_walks(&mut self, width: usize, height: usize) {
         if self.morton.0 != (width, height) {
             let order = RayOrder::Morton.offsets(width as u32, height as u32);
@@ -114,7 +115,7 @@ impl ShadowTracer<'_> {
             Shadows::MultiSample { samples, bound } => {
                 let mut out = Vec::with_capacity(surfaces.len());
                 let kernel = MultiSampled { st: self, surfaces, seeds, samples, bound, stats, sc, out: &mut out };
-                if self.tracer.options.method == Method::Reference {
+                if self.tracer.options.method.entry().walk == Walk::BruteForce {
                     kernel.trace_with(&mut ReferenceBundles { tracer: self.tracer });
                 } else {
                     raylab_simd::dispatch(self.tracer.options.backend, kernel);
@@ -147,7 +148,7 @@ impl ShadowTracer<'_> {
                 }
                 sc.rays.iter().zip(&sc.blocked).map(|(r, &b)| seen(r, b)).collect()
             }
-            Shadows::Cached if self.tracer.options.method.uses_dacrt() => {
+            Shadows::Cached if self.tracer.options.method.entry().walk == Walk::DacrtSet => {
                 sc.blocked.clear();
                 sc.blocked.resize(sc.rays.len(), false);
                 sc.cache.occluded_set(self.tracer, &sc.rays, &mut sc.blocked, stats);
@@ -159,8 +160,8 @@ impl ShadowTracer<'_> {
             }
             Shadows::EdgeWidth { radius, leak_fix } => {
                 // Every segment walks the tree: one that nothing blocks finds no crossing and sees the whole
-                // light. A hard-shadow pass first, to walk only the blocked ones, cost more than it saved
-                // (docs/BENCHMARKS.md, shading readings).
+                // light. A hard-shadow pass first, to walk only the blocked ones, would trace most segments
+                // twice, since most are blocked or graze a blocker.
                 // Scratch outlives frames (see `render`), whose edge settings may differ.
                 if sc.edge.first().is_none_or(|e| e.settings() != (radius, leak_fix)) {
                     sc.edge.clear();

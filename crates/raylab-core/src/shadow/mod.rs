@@ -5,11 +5,9 @@
 //! switch between them per frame and the traversal method only ever changes the speed, never the pixels.
 
 mod cache;
-mod edge_width;
 pub(crate) mod samples;
 
 pub use cache::ShadowCache;
-pub use edge_width::{Crossing, EdgeWidth};
 pub use samples::{LightSamples, concentric_disc, stratified_grid};
 
 use std::fmt;
@@ -29,8 +27,7 @@ use crate::trace::Proxy;
 #[serde(rename_all = "kebab-case")]
 pub enum SampleBound {
     /// The samples are traced as plain packets: the fastest here for 16 samples or fewer (a bundle of a
-    /// few rays spread over a wide light leaves most of its volume unsampled, and a frustum walks all of it;
-    /// docs/BENCHMARKS.md).
+    /// few rays spread over a wide light leaves most of its volume unsampled, and a frustum walks all of it).
     #[default]
     Packets,
     /// One pyramid frustum fitted to the point's actual samples (Listing 4.2 over their rays): the tightest

@@ -171,9 +171,9 @@ impl Structures {
         }
     }
 
-    /// The kd-tree `method` walks ([`Method::frame_kd`]), when built.
+    /// The kd-tree `method` walks ([`MethodEntry::frame_kd`](crate::method::MethodEntry::frame_kd)), when built.
     pub fn kd_for(&self, method: Method) -> Option<&KdTree> {
-        self.kd(method.frame_kd()?)
+        self.kd(method.entry().frame_kd?)
     }
 
     /// The MBVH, when built.

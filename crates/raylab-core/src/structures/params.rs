@@ -40,9 +40,9 @@ impl StructureParams {
         }
     }
 
-    /// The parameters of the kd-tree `method` walks ([`Method::frame_kd`]); the thesis's for the reference.
+    /// The parameters of the kd-tree `method` walks ([`MethodEntry::frame_kd`](crate::method::MethodEntry::frame_kd)); the thesis's for the reference.
     pub fn kd_for(&self, method: Method) -> &KdParams {
-        method.frame_kd().and_then(|s| self.kd_of(s)).unwrap_or(&self.kd)
+        method.entry().frame_kd.and_then(|s| self.kd_of(s)).unwrap_or(&self.kd)
     }
 
     /// Checks both kd-tree parameter sets; the message names the tree and the field.

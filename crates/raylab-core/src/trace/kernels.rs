@@ -5,8 +5,8 @@ use glam::Vec3;
 use raylab_simd::{Kernel, Vf32};
 
 use super::{TileScratch, Tracer};
+use crate::edge_width::EdgeWidth;
 use crate::ray::{Hit, Ray};
-use crate::shadow::EdgeWidth;
 use crate::stats::TraversalStats;
 
 /// [`Tracer::intersect_simd`] as a [`Kernel`], so the backend picks the lane type.

@@ -20,17 +20,17 @@ use raylab_simd::{Backend, VMask, Vf32};
 use serde::Serialize;
 
 use crate::dacrt::{Dacrt, DacrtParams};
+use crate::edge_width::EdgeWidth;
 use crate::intersector::Intersector;
 use crate::kdtree::KdTree;
 use crate::kdtree::mft::Frustum4;
 use crate::kdtree::packet::PacketStack;
 use crate::mbvh::{Mbvh, StreamLeaves, StreamOptions};
-use crate::method::{Method, Purpose};
+use crate::method::{BundleShape, Method, Purpose, Walk};
 use crate::packet::PacketTile;
 use crate::ray::{Hit, Ray};
+use crate::ray_order::RayOrder;
 use crate::reference::BruteForce;
-use crate::render::RayOrder;
-use crate::shadow::EdgeWidth;
 use crate::stats::TraversalStats;
 use crate::structures::{MissingStructure, Structures};
 use bundle::{Bundled, RayRect, common_origin, cone_from, frustum_from, toward_cone, toward_frustum};
@@ -91,7 +91,7 @@ impl Default for TraceOptions {
 /// Traces tiles of rays with one method through the [`Structures`] it was made from.
 #[derive(Clone, Copy)]
 pub struct Tracer<'a> {
-    /// The kd-tree the method walks ([`Method::frame_kd`]); `None` only for the reference and for a
+    /// The kd-tree the method walks ([`MethodEntry::frame_kd`](crate::method::MethodEntry::frame_kd)); `None` only for the reference and for a
     /// [`Tracer::for_rays`] of a method whose kernel is another structure.
     tree: Option<&'a KdTree>,
     reference: Option<&'a BruteForce>,
@@ -139,6 +139,11 @@ impl<'a> Tracer<'a> {
         self.reference.expect("checked by Structures::check: the reference method has its brute force")
     }
 
+    /// The kernel of the tracer's method.
+    fn walk(&self) -> Walk {
+        self.options.method.entry().walk
+    }
+
     fn stream_options(&self) -> StreamOptions {
         StreamOptions { ordered: self.options.stream_order, leaves: self.options.stream_leaves }
     }
@@ -146,21 +151,21 @@ impl<'a> Tracer<'a> {
     /// The same tracer with another traversal method over the same kd-tree (the brute-force reference stays
     /// the reference): sampled shadows trace their bundles with the packet or frustum kernels.
     pub fn with_method(&self, method: Method) -> Tracer<'a> {
-        let method = if self.options.method == Method::Reference { Method::Reference } else { method };
+        let method = if self.walk() == Walk::BruteForce { self.options.method } else { method };
         Tracer { options: TraceOptions { method, ..self.options }, ..*self }
     }
 
     /// The first blocker found along a single ray (for the shadow cache).
     pub fn occluder(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<u32> {
-        match self.options.method {
-            Method::Reference => self.reference().occluder(ray, stats),
-            Method::Mbvh | Method::MbvhRs => self.mbvh().occluder(ray, self.options.backend, stats),
-            Method::Dacrt => {
+        match self.walk() {
+            Walk::BruteForce => self.reference().occluder(ray, stats),
+            Walk::MbvhRay | Walk::MbvhStream => self.mbvh().occluder(ray, self.options.backend, stats),
+            Walk::DacrtSet => {
                 let mut out = [None];
                 self.dacrt().occluders(&self.options.dacrt, self.options.backend, &[Some(*ray)], &mut out, stats);
                 out[0]
             }
-            _ => self.tree().occluder(ray, stats),
+            Walk::KdRay | Walk::KdPacket | Walk::KdBundle(_) => self.tree().occluder(ray, stats),
         }
     }
 
@@ -168,7 +173,7 @@ impl<'a> Tracer<'a> {
     /// for DACRT, ray by ray for the other methods.
     pub fn occluders_tile(&self, rays: &[Option<Ray>], out: &mut [Option<u32>], stats: &mut TraversalStats) {
         assert_eq!(rays.len(), out.len());
-        if self.options.method == Method::Dacrt {
+        if self.walk() == Walk::DacrtSet {
             self.dacrt().occluders(&self.options.dacrt, self.options.backend, rays, out, stats);
             return;
         }
@@ -179,27 +184,27 @@ impl<'a> Tracer<'a> {
 
     /// True when triangle `tri` blocks `ray`.
     pub fn blocks(&self, ray: &Ray, tri: u32) -> bool {
-        match self.options.method {
-            Method::Reference => self.reference().blocks(ray, tri),
-            Method::Dacrt => self.dacrt().blocks(ray, tri),
-            Method::Mbvh | Method::MbvhRs => self.mbvh().blocks(ray, tri),
-            _ => self.tree().blocks(ray, tri),
+        match self.walk() {
+            Walk::BruteForce => self.reference().blocks(ray, tri),
+            Walk::DacrtSet => self.dacrt().blocks(ray, tri),
+            Walk::MbvhRay | Walk::MbvhStream => self.mbvh().blocks(ray, tri),
+            Walk::KdRay | Walk::KdPacket | Walk::KdBundle(_) => self.tree().blocks(ray, tri),
         }
     }
 
     /// The edge-width occlusion of a single shadow ray (thesis Listing 5.1): the kd-tree's walk for every
     /// method (also for the MBVH and DACRT methods, which do not visit leaves in distance order, which the
-    /// pairing relies on), or the brute-force reference for [`Method::Reference`].
+    /// pairing relies on), or the brute-force reference for [`Walk::BruteForce`].
     pub fn edge_width(&self, ray: &Ray, state: &mut EdgeWidth, stats: &mut TraversalStats) -> f32 {
-        match self.options.method {
-            Method::Reference => self.reference().edge_width(ray, state, stats),
+        match self.walk() {
+            Walk::BruteForce => self.reference().edge_width(ray, state, stats),
             _ => self.tree().edge_width(ray, state, stats),
         }
     }
 
     /// The edge-width occlusions of `rays`, written to `out`; `states` holds at least as many states as
     /// there are rays, and at least [`crate::packet::MAX_LANES`], all with the frame's radius and leak-fix
-    /// switch. The single-ray methods walk ray by ray (the reference by brute force). The bundled methods
+    /// switch. The single-ray kd-tree kernel walks ray by ray (the reference by brute force). The bundled methods
     /// walk rays that end at `toward` (a light) as one frustum or cone from there, when there are many and
     /// the bundle is narrow enough (see [`KdTree::edge_widths_bundle`]); the others, and few or widely spread
     /// rays, as kd-tree packets of rays with the same direction signs (see [`KdTree::edge_widths`]). All give
@@ -217,8 +222,8 @@ impl<'a> Tracer<'a> {
             states.len() >= rays.len().max(crate::packet::MAX_LANES),
             "edge_widths needs one state per ray and per packet lane"
         );
-        match self.options.method {
-            Method::Reference | Method::Mono => {
+        match self.walk() {
+            Walk::BruteForce | Walk::KdRay => {
                 for (o, r) in out.iter_mut().zip(rays) {
                     *o = self.edge_width(r, &mut states[0], stats);
                 }
@@ -241,9 +246,11 @@ impl<'a> Tracer<'a> {
         out: &mut [f32],
         stats: &mut TraversalStats,
     ) {
-        let method = self.options.method;
+        let bundle = self.options.method.entry().bundle();
         let TileScratch { stack, tile, rays: grid, .. } = scratch;
-        if let Some(toward) = toward.filter(|_| method.is_bundled() && rays.len() >= EDGE_BUNDLE_MIN_RAYS) {
+        if let Some(shape) = bundle
+            && let Some(toward) = toward.filter(|_| rays.len() >= EDGE_BUNDLE_MIN_RAYS)
+        {
             // The rays in packet order: a tile one packet wide whose packets hold consecutive rays.
             let pw = PacketTile::<V>::PACKET_W;
             let height = rays.len().div_ceil(pw);
@@ -259,7 +266,7 @@ impl<'a> Tracer<'a> {
             };
             let (limit, cull) = (self.options.shadow_spread_limit, self.options.cull);
             // `if let` rather than `Option::map` closures, whose vector code may stay out of line (see `map3`).
-            if matches!(method, Method::Cone | Method::MftCone) {
+            if shape.is_cone() {
                 if let Some(c) = toward_cone(&whole, toward, limit) {
                     self.tree().edge_widths_bundle(&c, tile, cull, states, out, stats);
                     return;
@@ -282,20 +289,20 @@ impl<'a> Tracer<'a> {
         stats: &mut TraversalStats,
     ) {
         assert!(rays.len() == width * height && out.len() == rays.len());
-        match self.options.method {
-            Method::Mono => closest_each(self.tree(), rays, out, stats),
-            Method::Reference => closest_each(self.reference(), rays, out, stats),
-            Method::Mbvh => {
+        match self.walk() {
+            Walk::KdRay => closest_each(self.tree(), rays, out, stats),
+            Walk::BruteForce => closest_each(self.reference(), rays, out, stats),
+            Walk::MbvhRay => {
                 let (mbvh, backend) = (self.mbvh(), self.options.backend);
                 for (o, r) in out.iter_mut().zip(rays) {
                     *o = r.and_then(|r| mbvh.intersect(&r, backend, stats));
                 }
             }
-            Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
+            Walk::MbvhStream => self.in_groups(rays, width, height, out, |r, o| {
                 self.mbvh().intersect_stream(r, o, self.stream_options(), self.options.backend, stats)
             }),
-            Method::Dacrt => self.dacrt().intersect(&self.options.dacrt, self.options.backend, rays, out, stats),
-            _ => raylab_simd::dispatch(
+            Walk::DacrtSet => self.dacrt().intersect(&self.options.dacrt, self.options.backend, rays, out, stats),
+            Walk::KdPacket | Walk::KdBundle(_) => raylab_simd::dispatch(
                 self.options.backend,
                 IntersectSimd { tracer: self, rays, width, height, out, stats },
             ),
@@ -313,20 +320,20 @@ impl<'a> Tracer<'a> {
         stats: &mut TraversalStats,
     ) {
         assert!(rays.len() == width * height && out.len() == rays.len());
-        match self.options.method {
-            Method::Mono => occluded_each(self.tree(), rays, out, stats),
-            Method::Reference => occluded_each(self.reference(), rays, out, stats),
-            Method::Mbvh => {
+        match self.walk() {
+            Walk::KdRay => occluded_each(self.tree(), rays, out, stats),
+            Walk::BruteForce => occluded_each(self.reference(), rays, out, stats),
+            Walk::MbvhRay => {
                 let (mbvh, backend) = (self.mbvh(), self.options.backend);
                 for (o, r) in out.iter_mut().zip(rays) {
                     *o = r.is_some_and(|r| mbvh.occluded(&r, backend, stats));
                 }
             }
-            Method::MbvhRs => self.in_groups(rays, width, height, out, |r, o| {
+            Walk::MbvhStream => self.in_groups(rays, width, height, out, |r, o| {
                 self.mbvh().occluded_stream(r, o, self.stream_options(), self.options.backend, stats)
             }),
-            Method::Dacrt => self.dacrt().occluded(&self.options.dacrt, self.options.backend, rays, out, stats),
-            _ => raylab_simd::dispatch(
+            Walk::DacrtSet => self.dacrt().occluded(&self.options.dacrt, self.options.backend, rays, out, stats),
+            Walk::KdPacket | Walk::KdBundle(_) => raylab_simd::dispatch(
                 self.options.backend,
                 OccludedSimd { tracer: self, rays, width, height, toward, out, stats },
             ),
@@ -385,26 +392,27 @@ impl<'a> Tracer<'a> {
         // Tiles no bundle covers are traced as packets (after the match, so the packet kernel is inlined once).
         let cull = self.options.cull;
         // The rays' common origin, found once for the tile: every bundle of its packets starts there.
-        let shared = if self.options.method.is_bundled() { common_origin(&tile.packets) } else { None };
+        let bundle = self.options.method.entry().bundle();
+        let shared = if bundle.is_some() { common_origin(&tile.packets) } else { None };
         if cull && let Some(origin) = shared {
             tile.share_origin(origin);
         }
-        let bundled = match (self.options.method, shared) {
-            (Method::Frustum, Some(o)) => {
+        let bundled = match (bundle, shared) {
+            (Some(BundleShape::Frustum), Some(o)) => {
                 let f = frustum_from(o, tile, all.clone());
                 if let Some(f) = &f {
                     self.tree().intersect_frustum(f, tile, all, cull, stats);
                 }
                 f.is_some()
             }
-            (Method::Cone, Some(o)) => {
+            (Some(BundleShape::Cone), Some(o)) => {
                 let c = cone_from(o, tile, all.clone());
                 if let Some(c) = &c {
                     self.tree().intersect_frustum(c, tile, all, cull, stats);
                 }
                 c.is_some()
             }
-            (Method::Mft, _) => {
+            (Some(BundleShape::MftFrustums), _) => {
                 if let Some((b, sets, _)) = self.quadrants(tile, rays, None, shared, frustum_from, toward_frustum)
                     && let Some(f4) = Frustum4::new(b)
                 {
@@ -414,7 +422,7 @@ impl<'a> Tracer<'a> {
                     false
                 }
             }
-            (Method::MftCone, _) => {
+            (Some(BundleShape::MftCones), _) => {
                 if let Some((b, sets, _)) = self.quadrants(tile, rays, None, shared, cone_from, toward_cone)
                     && let Some(c4) = Frustum4::new(b)
                 {
@@ -468,7 +476,8 @@ impl<'a> Tracer<'a> {
         blocked.resize(tile.packets.len(), V::Mask::from_bits(0));
         let all = 0..tile.packets.len();
         // The rays' common origin when they have one (camera rays), found once for the tile.
-        let shared = if self.options.method.is_bundled() { common_origin(&tile.packets) } else { None };
+        let bundle = self.options.method.entry().bundle();
+        let shared = if bundle.is_some() { common_origin(&tile.packets) } else { None };
         if self.options.cull
             && let Some(origin) = shared
         {
@@ -483,27 +492,33 @@ impl<'a> Tracer<'a> {
         // and walks far side first.
         let far_first = |apex: Vec3| Some(apex) != shared;
         let cull = self.options.cull;
-        match self.options.method {
-            Method::Frustum => {
+        match bundle {
+            Some(BundleShape::Frustum) => {
                 match self.whole(tile, all.clone(), rays, toward, shared, frustum_from, toward_frustum) {
                     Some(f) => self.tree().occluded_frustum(&f, tile, all, cull, far_first(f.origin), blocked, stats),
                     None => rest[0] = all,
                 }
             }
-            Method::Cone => match self.whole(tile, all.clone(), rays, toward, shared, cone_from, toward_cone) {
-                Some(c) => self.tree().occluded_frustum(&c, tile, all, cull, far_first(c.bound.origin), blocked, stats),
-                None => rest[0] = all,
-            },
-            Method::Mft => match self.quadrants(tile, rays, toward, shared, frustum_from, toward_frustum) {
-                Some((b, sets, left)) => {
-                    if let Some(f4) = Frustum4::new(b) {
-                        self.tree().occluded_mft(&f4, tile, &sets, cull, far_first(f4.origin()), blocked, stats);
+            Some(BundleShape::Cone) => {
+                match self.whole(tile, all.clone(), rays, toward, shared, cone_from, toward_cone) {
+                    Some(c) => {
+                        self.tree().occluded_frustum(&c, tile, all, cull, far_first(c.bound.origin), blocked, stats)
                     }
-                    rest = left;
+                    None => rest[0] = all,
                 }
-                None => rest[0] = all,
-            },
-            Method::MftCone => match self.quadrants(tile, rays, toward, shared, cone_from, toward_cone) {
+            }
+            Some(BundleShape::MftFrustums) => {
+                match self.quadrants(tile, rays, toward, shared, frustum_from, toward_frustum) {
+                    Some((b, sets, left)) => {
+                        if let Some(f4) = Frustum4::new(b) {
+                            self.tree().occluded_mft(&f4, tile, &sets, cull, far_first(f4.origin()), blocked, stats);
+                        }
+                        rest = left;
+                    }
+                    None => rest[0] = all,
+                }
+            }
+            Some(BundleShape::MftCones) => match self.quadrants(tile, rays, toward, shared, cone_from, toward_cone) {
                 Some((b, sets, left)) => {
                     if let Some(c4) = Frustum4::new(b) {
                         self.tree().occluded_mft(&c4, tile, &sets, cull, far_first(c4.origin()), blocked, stats);
@@ -512,7 +527,7 @@ impl<'a> Tracer<'a> {
                 }
                 None => rest[0] = all,
             },
-            _ => rest[0] = all,
+            None => rest[0] = all,
         }
         let tree = self.tree();
         for j in rest.into_iter().flatten() {
@@ -541,10 +556,8 @@ fn occluded_each<I: Intersector>(i: &I, rays: &[Option<Ray>], out: &mut [bool], 
 
 /// The fewest edge-width segments the bundled methods walk as one bundle; fewer go as packets. A bundle
 /// descends more loosely than packets (its frustum holds all the segments) and tests each leaf against every
-/// packet that may reach it, which pays only when many packets share the descent: on the Sponza view at
-/// 1280x720 the bundle walks take the shadow stage 0.89x with this limit and with none, while at 512x512,
-/// whose tiles hold fewer and less coherent segments, walking every tile as a bundle was 1.02-1.04x slower
-/// (both measured when only the blocked segments walked, in row order).
+/// packet that may reach it, which pays only when many packets share the descent. Large frames' tiles hold
+/// many coherent segments and gain from bundles; small frames' tiles hold few and scattered ones, which lose.
 const EDGE_BUNDLE_MIN_RAYS: usize = 128;
 
 /// Single rays through the tracer's method, each as a tile of one (the method's kernels, backend and options).

@@ -9,7 +9,7 @@
 use glam::Vec3;
 use raylab_simd::{Kernel, VMask, Vf32};
 
-use crate::method::Method;
+use crate::method::Walk;
 use crate::packet::{Cone, Frustum};
 use crate::ray::Ray;
 use crate::stats::TraversalStats;
@@ -38,7 +38,7 @@ impl Proxy {
 impl Tracer<'_> {
     /// Marks in `out` which rays of a `width x height` tile something blocks, walking the kd-tree once with
     /// `proxy`, which must hold every ray's segment (all start at its apex). The brute-force reference
-    /// ([`Method::Reference`]) ignores the proxy and tests every ray alone, so the proxies are checked
+    /// ([`Walk::BruteForce`]) ignores the proxy and tests every ray alone, so the proxies are checked
     /// against it.
     pub fn occluded_in_proxy(
         &self,
@@ -49,7 +49,7 @@ impl Tracer<'_> {
         stats: &mut TraversalStats,
     ) {
         assert!(rays.len() == width * height && out.len() == rays.len());
-        if self.options.method == Method::Reference {
+        if self.options.method.entry().walk == Walk::BruteForce {
             return self.occluded_tile(rays, width, height, None, out, stats);
         }
         raylab_simd::dispatch(

@@ -13,8 +13,7 @@ use crate::ray::Ray;
 
 /// The buffers of a tile's occlusion walk ([`Tracer::occluded_simd`], [`Tracer::occluded_in_proxy_simd`]),
 /// kept by kernels that trace many small tiles (a point's light samples) so that each does not allocate
-/// them anew (cut anew, a 16-sample tile's packets cost two thirds as much as its proxy walk;
-/// docs/BENCHMARKS.md, shading readings).
+/// them anew (for a tile of a few samples, allocating would cost about as much as the walk).
 pub(crate) struct TileScratch<V: Vf32> {
     /// Per packet, its blocked lanes.
     pub blocked: Vec<V::Mask>,

@@ -1,7 +1,7 @@
 //! The live method-comparison table: rows arrive from the worker as they are measured; clicking a column
 //! header sorts by it.
 
-use crate::compare::CompareRow;
+use crate::tracer::compare::CompareRow;
 
 /// Sortable columns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -129,7 +129,7 @@ impl CompareTable {
                 }
                 ui.small(format!(
                     "median of {} frames per row after a warm-up; N and I per 2x2 packet as in thesis Tables 4.1-4.5",
-                    crate::compare::TIMED_FRAMES
+                    crate::tracer::compare::TIMED_FRAMES
                 ));
                 if !self.rows.is_empty() && ui.button("Copy as markdown").clicked() {
                     ui.ctx().copy_text(self.markdown());

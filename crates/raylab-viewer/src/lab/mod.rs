@@ -10,16 +10,17 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use raylab_bench::args::SceneArgs;
+use raylab_cli::args::SceneArgs;
 use raylab_core::scene::PointLight;
 use raylab_core::structures::StructureParams;
 
-use crate::camera_path::{CameraPath, Player, Recorder};
-use crate::fly::{FlyCamera, MoveKeys};
-use crate::fly_scale::{FLY_BUDGET, FlyScale, scale_for_budget};
+use crate::camera::fly::{FlyCamera, MoveKeys};
+use crate::camera::fly_scale::{FLY_BUDGET, FlyScale, scale_for_budget};
+use crate::camera::paths::{CameraPath, Player, Recorder};
 use crate::loader::{LoadPoll, LoadedScene, PendingLoad};
 use crate::settings::{RenderMode, ViewerSettings};
-use crate::worker::{Job, ReflectionJob, Rendered, Worker, WorkerEvent};
+use crate::tracer::jobs::{Job, ReflectionJob, Rendered};
+use crate::tracer::worker::{Worker, WorkerEvent};
 pub use bookmarks::Bookmarks;
 use compare_table::CompareTable;
 pub use readouts::{HybridReport, Readouts, StatsReport};
@@ -469,7 +470,7 @@ impl Lab {
 
     /// The job for the next frame: [`Lab::job`], at a lower scale while the user flies the camera (a played
     /// camera path never) and a frame at the chosen scale would take longer than the fly budget, as the
-    /// latest frame's time per pixel predicts ([`crate::fly_scale`]).
+    /// latest frame's time per pixel predicts ([`crate::camera::fly_scale`]).
     fn next_job(&mut self) -> Job {
         let mut job = self.job();
         let chosen = job.settings.scale;
@@ -599,7 +600,8 @@ mod tests {
 
     use raylab_core::kdtree::KdParams;
     use raylab_core::method::Method;
-    use raylab_core::render::{FrameView, RayOrder};
+    use raylab_core::ray_order::RayOrder;
+    use raylab_core::render::FrameView;
     use raylab_core::trace::TraceOptions;
 
     use super::*;
@@ -697,7 +699,7 @@ mod tests {
         l.set_window_size(16, 16);
         l.start_compare();
         wait(&mut l, |l| !l.compare.running());
-        let want = crate::compare::compare_configs(8);
+        let want = crate::tracer::compare::compare_configs(8);
         assert_eq!(l.compare.rows.len(), want.len());
         for (row, (m, t)) in l.compare.rows.iter().zip(&want) {
             assert_eq!((row.method, row.tile), (*m, *t));
@@ -726,7 +728,7 @@ mod tests {
         let job = l.job();
         let frames: Vec<_> = [Method::Mono, Method::Packet, Method::Mft, Method::Frustum]
             .into_iter()
-            .map(|m| crate::worker::trace_frame(&job, m).frame)
+            .map(|m| crate::tracer::jobs::trace_frame(&job, m).frame)
             .collect();
         for f in &frames[1..] {
             assert!(f.stats.rays > 0);
@@ -753,7 +755,7 @@ mod tests {
             assert_eq!(r.settings.scale, if on { 25 } else { 100 });
             let again = l.flying.settled() || l.flying.settle_in().is_some();
             assert_eq!(again, on, "a reduced frame is to be traced again at the chosen scale");
-            std::thread::sleep(crate::fly_scale::SETTLE);
+            std::thread::sleep(crate::camera::fly_scale::SETTLE);
             l.tick(0.0);
             wait(&mut l, |l| l.latest().is_some_and(|r| r.settings.scale == 100) && !l.dirty);
             let f = &l.latest().unwrap().frame;

@@ -3,19 +3,20 @@
 
 use raylab_core::dacrt::{DacrtParams, SplitRule};
 use raylab_core::mbvh::StreamLeaves;
-use raylab_core::method::Method;
-use raylab_core::render::{FrameView, RayOrder};
+use raylab_core::method::{Method, Walk};
+use raylab_core::ray_order::RayOrder;
+use raylab_core::render::FrameView;
 use raylab_simd::Backend;
 
 use super::{Lab, Shot};
 use crate::animated::UpdateTimes;
-use crate::camera_path::CameraPath;
+use crate::camera::paths::CameraPath;
 use crate::cli::value_name;
 use raylab_core::render::RenderSettings;
 use raylab_core::shadow::{SampleBound, ShadowKind, Shadows};
 
 use crate::settings::{HybridControls, RenderMode, ViewerSettings};
-use crate::worker::HybridFrame;
+use crate::tracer::jobs::HybridFrame;
 
 /// Draws the panel.
 pub fn show(lab: &mut Lab, ui: &mut egui::Ui) {
@@ -68,7 +69,7 @@ fn scene_section(lab: &mut Lab, ui: &mut egui::Ui) {
         ui.small("or drop an .obj, .gltf or .glb file on the window");
         let s = &lab.scene;
         let method = lab.settings.frame_method();
-        let built = method.frame_kd().and_then(|k| s.structures.built(k));
+        let built = method.entry().frame_kd.and_then(|k| s.structures.built(k));
         if let Some((built, stats)) = built.and_then(|b| Some((b, b.kd?))) {
             ui.label(format!(
                 "{} triangles; the method's kd-tree: {} nodes (depth {}, C_trav {}), built in {:.2} s",
@@ -144,7 +145,7 @@ fn camera_section(lab: &mut Lab, ui: &mut egui::Ui) {
                     lab.stop_recording();
                 }
             } else if ui.add_enabled(lab.player.is_none(), egui::Button::new("Record")).clicked() {
-                lab.recorder = Some(crate::camera_path::Recorder::start(&lab.scene.name, lab.fly.camera));
+                lab.recorder = Some(crate::camera::paths::Recorder::start(&lab.scene.name, lab.fly.camera));
             }
             if let Some(p) = &lab.player {
                 let (i, n) = p.progress();
@@ -191,15 +192,16 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
                 ui.small(format!("{paths} paths per pixel so far"));
             }
         }
-        let probe = *s;
         egui::ComboBox::from_label("method").selected_text(s.trace.method.name()).show_ui(ui, |ui| {
             for m in Method::ALL {
-                let why = probe.method_unavailable(m);
-                let r = ui.add_enabled(why.is_none(), egui::Button::selectable(s.trace.method == m, m.name()));
+                let e = m.entry();
+                let r = ui
+                    .add_enabled(e.not_live.is_none(), egui::Button::selectable(s.trace.method == m, m.name()))
+                    .on_hover_text(format!("{} ({})", e.summary, e.source));
                 if r.clicked() {
                     s.trace.method = m;
                 }
-                if let Some(why) = why {
+                if let Some(why) = e.not_live {
                     r.on_disabled_hover_text(why);
                 }
             }
@@ -209,16 +211,16 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
                 ui.selectable_value(&mut s.tile, t, format!("{t}x{t}"));
             }
         });
-        let frustums = s.trace.method.uses_tiles();
+        let frustums = s.trace.method.entry().tile_matters();
         ui.add_enabled(frustums, egui::Checkbox::new(&mut s.trace.cull, "packet/leaf culling"))
             .on_disabled_hover_text("only the frustum methods cull packets at leaves");
         ui.add_enabled(
-            s.trace.method == Method::MbvhRs,
+            s.trace.method.entry().walk == Walk::MbvhStream,
             egui::Checkbox::new(&mut s.trace.stream_order, "stream ordering"),
         )
         .on_hover_text("walk MBVH RS children by accumulated hit length (the paper's heuristic)")
         .on_disabled_hover_text("only mbvh-rs orders its child tasks");
-        ui.add_enabled_ui(s.trace.method == Method::MbvhRs, |ui| {
+        ui.add_enabled_ui(s.trace.method.entry().walk == Walk::MbvhStream, |ui| {
             egui::ComboBox::from_label("stream leaves").selected_text(s.trace.stream_leaves.name()).show_ui(ui, |ui| {
                 for l in StreamLeaves::ALL {
                     ui.selectable_value(&mut s.trace.stream_leaves, l, l.name());
@@ -228,7 +230,7 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
         .response
         .on_hover_text("MBVH RS leaf test: ray pairs against four-triangle blocks, or the paper's four-ray packets")
         .on_disabled_hover_text("only mbvh-rs streams rays through leaves");
-        if s.trace.method.uses_dacrt() {
+        if s.trace.method.entry().walk == Walk::DacrtSet {
             dacrt_controls(ui, s);
         }
         egui::ComboBox::from_label("SIMD").selected_text(s.trace.backend.name()).show_ui(ui, |ui| {
@@ -242,7 +244,7 @@ fn render_section(lab: &mut Lab, ui: &mut egui::Ui) {
             egui::Slider::new(&mut s.trace.shadow_spread_limit, 0.0..=0.5).text("shadow spread limit"),
         )
         .on_hover_text("widest shadow bundle traced as a frustum; wider ones go as 2x2 packets");
-        let single = !s.trace.method.uses_packets();
+        let single = !s.trace.method.entry().packets();
         ui.add_enabled_ui(single, |ui| {
             egui::ComboBox::from_label("ray order").selected_text(s.order.name()).show_ui(ui, |ui| {
                 for o in RayOrder::ALL {
@@ -373,7 +375,7 @@ fn dacrt_controls(ui: &mut egui::Ui, s: &mut ViewerSettings) {
             ui.selectable_value(&mut d.split, r, r.name());
         }
     });
-    let edge = Method::Dacrt.tile_edge(s.tile, 1);
+    let edge = Method::Dacrt.entry().tile_edge(s.tile, 1);
     if edge != s.tile {
         ui.small(format!("DACRT traces {edge}x{edge} tiles: smaller ray sets repeat the division of every triangle"));
     }

@@ -10,7 +10,7 @@ use raylab_core::stats::TraversalStats;
 use serde::Serialize;
 
 use crate::cpu_clock::Cost;
-use crate::worker::Rendered;
+use crate::tracer::jobs::Rendered;
 
 /// Seconds of history the plots show.
 const HISTORY_S: f64 = 20.0;

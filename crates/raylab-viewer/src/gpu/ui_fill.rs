@@ -12,7 +12,7 @@
 use egui::epaint::{Mesh, Primitive, Vertex};
 use egui::{ClippedPrimitive, Rect};
 
-use crate::ui_cover::PixelRect;
+use crate::gpu::ui_cover::PixelRect;
 
 /// A solid rectangle of egui's output: its pixels and its colour (egui's premultiplied sRGBA bytes, what its
 /// shader writes for them).

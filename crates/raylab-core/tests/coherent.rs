@@ -78,7 +78,7 @@ fn check_view(scene: &Scene, cam: &Camera, light: Vec3, w: usize, h: usize, what
     let (want_hits, _) = trace_image(&mono, &primary, w, h, 8, None);
     let (_, want_occ) = trace_image(&mono, &shadow, w, h, 8, Some(light));
     let walks = METHODS.into_iter().flat_map(|m| {
-        let own_tree = m.uses_packets().then_some((m, &own, "own tree"));
+        let own_tree = m.entry().packets().then_some((m, &own, "own tree"));
         [Some((m, &thesis, "mono's tree")), own_tree].into_iter().flatten()
     });
     for (method, walked, which) in walks {

@@ -16,11 +16,11 @@ use raylab_core::scene::Scene;
 use raylab_scene::animation::Animation;
 use readback::Readback;
 
-use crate::compositor::Compositor;
-use crate::gpu::Gpu;
+use crate::gpu::compositor::Compositor;
+use crate::gpu::device::Gpu;
 use crate::lab::Lab;
 use crate::loader::LoadedScene;
-use crate::worker::{HybridFrame, Job, ReflectionJob};
+use crate::tracer::jobs::{HybridFrame, Job, ReflectionJob};
 
 /// A rasterised G-buffer on its way back to the CPU.
 struct InFlight {
@@ -190,7 +190,7 @@ mod tests {
 
     use super::gbuffer::GBufferPass;
     use super::readback::Readback;
-    use crate::gpu::Gpu;
+    use crate::gpu::device::Gpu;
 
     /// The GPU's G-buffer (under lavapipe in CI) gives reflections within 35 dB of the CPU Whitted renderer's
     /// first reflections over the pixels both see as reflective, and flags nearly the same pixels.

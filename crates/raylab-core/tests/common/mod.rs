@@ -44,6 +44,9 @@ impl Intersector for Lanes<'_, Dacrt> {
 }
 
 /// The structures `methods` need for frames, with the default parameters.
+/// The six axis directions, both signs: rays with two zero direction components.
+pub const AXES: [Vec3; 6] = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z];
+
 pub fn structures(scene: &Scene, methods: &[Method]) -> Structures {
     Structures::build(scene, methods, Purpose::Frames, &StructureParams::default()).unwrap()
 }
@@ -80,19 +83,14 @@ pub fn adversarial_rays(scene: &Scene, tree: &KdTree, n: usize, seed: u32) -> Ve
     let (lo, hi) = (b.min - pad, b.max + pad);
     let point = |rng: &mut Jitter| Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
     let mut rays = Vec::new();
-    let axis_dirs = [
-        Vec3::X,
-        Vec3::NEG_X,
-        Vec3::Y,
-        Vec3::NEG_Y,
-        Vec3::Z,
-        Vec3::NEG_Z,
+    let signed_zeros = [
         Vec3::new(1.0, -0.0, 0.0),
         Vec3::new(-0.0, 0.0, -1.0),
         Vec3::new(0.0, 0.7, -0.7),
         Vec3::new(-0.6, 0.0, 0.8),
         Vec3::new(0.5, -0.5, -0.0),
     ];
+    let axis_dirs: Vec<Vec3> = AXES.into_iter().chain(signed_zeros).collect();
     for k in 0..n {
         let o = point(&mut rng);
         let random_dir = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));

@@ -1,8 +1,8 @@
 //! Screenshots of the whole window: the same draw as the window's, into an offscreen texture that is copied
 //! to a buffer and read back (rows padded to wgpu's 256-byte copy alignment, BGRA swizzled to RGBA).
 
-use crate::compositor::Compositor;
-use crate::gpu::Gpu;
+use crate::gpu::compositor::Compositor;
+use crate::gpu::device::Gpu;
 
 /// Draws the window's contents (the latest frame and the UI last handed to [`Compositor::prepare_egui`])
 /// offscreen at `size` and returns them as an RGBA image.

@@ -6,8 +6,8 @@ use raylab_core::render::shade::{AMBIENT, DIRECT};
 use raylab_core::scene::{MaterialKind, PointLight, Scene};
 
 use super::gbuffer::{TARGET_FORMAT, Targets};
-use crate::compositor::{FRAME_FORMAT, fullscreen_pipeline};
-use crate::gpu::Gpu;
+use crate::gpu::compositor::{FRAME_FORMAT, fullscreen_pipeline};
+use crate::gpu::device::Gpu;
 
 /// Materials the composite pass knows (later ones are drawn with the last).
 pub const MATERIALS: usize = 256;
@@ -30,7 +30,7 @@ impl CompositePass {
     pub fn new(device: &wgpu::Device) -> Self {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("composite.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../../../shaders/composite.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../../../../shaders/composite.wgsl").into()),
         });
         let texture = |binding| wgpu::BindGroupLayoutEntry {
             binding,

@@ -4,10 +4,9 @@
 //! On Linux the tracer runs [`NICE_BELOW_UI`] niceness steps below the UI rather than at the lowest priority
 //! (19). At 19 (a scheduler weight of 15 against the 1024 of the UI's and lavapipe's threads), a tracer
 //! thread that lavapipe preempts in the middle of a tile waits on that core until lavapipe's draw is done; the
-//! frame cannot end before that tile, so the other tracer thread, out of tiles, sleeps and its core idles. On
-//! the shared Sponza view at 512x512 under Xvfb, 14-29% of the two cores stayed idle with the tracer at
-//! niceness 19, 17-26% at 9 and 2-4% at 5 (weight 335, about a quarter of a contested core), while the UI
-//! still drew 47-58 frames a second as the tracer ran (`docs/BENCHMARKS.md`, the viewer section).
+//! frame cannot end before that tile, so the other tracer thread, out of tiles, sleeps and its core idles.
+//! Five steps below (weight 335, about a quarter of a contested core) keeps both cores busy while the UI
+//! still draws smoothly as the tracer runs.
 
 /// How many niceness steps below the UI thread the tracer's threads run on Linux.
 #[cfg(target_os = "linux")]

@@ -2,17 +2,17 @@
 //! full-target triangle (`shaders/frame.wgsl`), then the egui panels over it.
 //!
 //! egui's output is drawn into a texture of its own (the UI layer; its opaque base, the side panel's
-//! background, filled without egui's shader, [`crate::ui_fill`]), which is laid over the frame where egui
-//! drew (the cells its triangles touch, [`crate::ui_cover`]); its meshes are uploaded and drawn again only
+//! background, filled without egui's shader, [`crate::gpu::ui_fill`]), which is laid over the frame where egui
+//! drew (the cells its triangles touch, [`crate::gpu::ui_cover`]); its meshes are uploaded and drawn again only
 //! when they changed. A redraw of the unchanged UI, the common case while frames stream in or the UI is asked
 //! to redraw often, then costs a copy of the frame around the opaque base (which would hide it) and a blend of
 //! the UI's pixels. It matters most on software Vulkan (lavapipe), where egui's fragment shader costs tens of
 //! milliseconds of CPU per draw of a 1280x720 window with the panel, time taken from the tracer on the same
 //! cores.
 
-use crate::gpu::Gpu;
-use crate::ui_cover::{PixelRect, drawn_rects};
-use crate::ui_fill::{SolidBase, around, split_solid_base};
+use crate::gpu::device::Gpu;
+use crate::gpu::ui_cover::{PixelRect, drawn_rects};
+use crate::gpu::ui_fill::{SolidBase, around, split_solid_base};
 
 /// Format of the frame texture: display-ready 8-bit values.
 pub const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -81,7 +81,7 @@ struct UiLayer {
     pixels_per_point: f32,
     /// The pixels egui drew, as disjoint rectangles (see [`drawn_rects`]).
     rects: Vec<PixelRect>,
-    /// Where the layer is opaque (its solid base, see [`crate::ui_fill`]): the frame below is hidden there.
+    /// Where the layer is opaque (its solid base, see [`crate::gpu::ui_fill`]): the frame below is hidden there.
     opaque: Option<PixelRect>,
 }
 
@@ -109,7 +109,7 @@ pub struct Compositor {
     ui: Option<UiLayer>,
     /// The meshes and screen (size in pixels, pixels per point) last handed to [`Compositor::prepare_egui`].
     ui_jobs: Vec<egui::ClippedPrimitive>,
-    /// Their solid base, which the compositor fills itself ([`crate::ui_fill`]), and the meshes egui's
+    /// Their solid base, which the compositor fills itself ([`crate::gpu::ui_fill`]), and the meshes egui's
     /// renderer draws: the rest.
     ui_base: Option<SolidBase>,
     ui_drawn: Vec<egui::ClippedPrimitive>,
@@ -129,7 +129,7 @@ impl Compositor {
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("frame.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/frame.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../../../shaders/frame.wgsl").into()),
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),

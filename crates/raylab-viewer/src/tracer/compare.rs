@@ -5,7 +5,7 @@ use raylab_core::method::Method;
 use serde::Serialize;
 
 use crate::settings::ViewerSettings;
-use crate::worker::{Job, trace_frame};
+use crate::tracer::jobs::{Job, trace_frame};
 
 /// Timed frames per configuration (after one untimed warm-up frame); the median is kept.
 pub const TIMED_FRAMES: usize = 3;
@@ -36,10 +36,10 @@ pub struct CompareRow {
 pub fn compare_configs(current_tile: u32) -> Vec<(Method, u32)> {
     let mut v = Vec::new();
     for m in Method::ALL {
-        if m == Method::Reference {
+        if m.entry().not_live.is_some() {
             continue;
         }
-        if m.uses_tiles() {
+        if m.entry().tile_matters() {
             v.extend(ViewerSettings::TILES.iter().map(|&t| (m, t)));
         } else {
             v.push((m, current_tile));
@@ -79,8 +79,8 @@ mod tests {
         for m in Method::ALL {
             let n = c.iter().filter(|(x, _)| *x == m).count();
             let want = match m {
-                Method::Reference => 0,
-                m if m.uses_tiles() => ViewerSettings::TILES.len(),
+                _ if m.entry().not_live.is_some() => 0,
+                m if m.entry().tile_matters() => ViewerSettings::TILES.len(),
                 _ => 1,
             };
             assert_eq!(n, want, "{m}");

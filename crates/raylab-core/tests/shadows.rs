@@ -5,6 +5,7 @@
 mod common;
 
 use glam::Vec3;
+use raylab_core::edge_width::EdgeWidth;
 use raylab_core::kdtree::KdParams;
 use raylab_core::method::{Method, Purpose, Structure};
 use raylab_core::packet::MAX_LANES;
@@ -13,7 +14,7 @@ use raylab_core::reference::BruteForce;
 use raylab_core::render::shade::Surface;
 use raylab_core::render::{RenderSettings, ShadowScratch, ShadowTracer, render, surface_epsilon};
 use raylab_core::scene::{Camera, Material, PointLight, Scene};
-use raylab_core::shadow::{EdgeWidth, SampleBound, Shadows};
+use raylab_core::shadow::{SampleBound, Shadows};
 use raylab_core::stats::TraversalStats;
 use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::trace::{TraceOptions, Tracer};

@@ -38,7 +38,7 @@ impl GBufferPass {
     pub fn new(device: &wgpu::Device) -> Self {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("gbuffer.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../../../shaders/gbuffer.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../../../../shaders/gbuffer.wgsl").into()),
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer camera"),

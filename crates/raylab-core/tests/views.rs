@@ -4,7 +4,8 @@
 
 use raylab_core::kdtree::KdParams;
 use raylab_core::method::{Method, Purpose};
-use raylab_core::render::{Frame, FrameView, RayOrder, RenderSettings, heat_color, render};
+use raylab_core::ray_order::RayOrder;
+use raylab_core::render::{Frame, FrameView, RenderSettings, heat_color, render};
 use raylab_core::structures::{StructureParams, Structures};
 use raylab_core::trace::{TraceOptions, Tracer};
 use raylab_scene::builtin::{self, Detail};

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{Lanes, adversarial_rays, check_hits, incoherent, scaled_scenes};
+use common::{AXES, Lanes, adversarial_rays, check_hits, incoherent, scaled_scenes};
 use glam::Vec3;
 use raylab_core::dacrt::{Dacrt, DacrtParams, SplitRule};
 use raylab_core::kdtree::{KdParams, KdTree};
@@ -273,16 +273,7 @@ fn camera_inside_geometry() {
     let d = Dacrt::new(&scene);
     let p = DacrtParams::default();
     let inside = [Vec3::new(8.0, 2.0, 0.0), Vec3::new(-19.0, -0.1, -19.0), Vec3::new(0.0, 4.0, 20.5)];
-    let dirs = [
-        Vec3::X,
-        Vec3::NEG_X,
-        Vec3::Y,
-        Vec3::NEG_Y,
-        Vec3::Z,
-        Vec3::NEG_Z,
-        Vec3::new(1.0, 1.0, -1.0),
-        Vec3::new(-0.0, 1.0, 0.0),
-    ];
+    let dirs: Vec<Vec3> = AXES.into_iter().chain([Vec3::new(1.0, 1.0, -1.0), Vec3::new(-0.0, 1.0, 0.0)]).collect();
     let rays: Vec<Ray> = inside.iter().flat_map(|&o| dirs.iter().map(move |&d| Ray::new(o, d))).collect();
     check_sets(&scene, &Lanes(&d, Backend::detect()), &p, &rays, rays.len(), "inside geometry");
 }
